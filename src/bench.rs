@@ -1,0 +1,164 @@
+//! `poolsim bench`: physical events per second and nanoseconds per event of the event-list engine
+//! on the thesis gas, over ball counts and area fractions, with the machine's description.
+//!
+//! Setup (generating the gas and predicting every ball's first event) is timed apart from the
+//! event loop, so the figures are the steady cost of an event. Each configuration runs a fixed
+//! number of events on one thread.
+
+use crate::engine::event_list::{EventList, Options};
+use crate::engine::Ignore;
+use crate::scenario::builtin::{self, Params};
+use serde_json::json;
+use std::time::Instant;
+
+/// Arguments of `poolsim bench`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct BenchArgs {
+    /// Ball counts (each rounded to a square number).
+    #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000")]
+    pub balls: Vec<usize>,
+    /// Area fractions.
+    #[arg(long = "area-fractions", value_delimiter = ',', default_value = "0.3,0.6")]
+    pub area_fractions: Vec<f64>,
+    /// Physical events measured per configuration (at least 5 per ball are run).
+    #[arg(long, default_value_t = 2_000_000)]
+    pub events: u64,
+    /// Grid cell width in ball diameters.
+    #[arg(long = "cell-diameters", default_value_t = 1.0)]
+    pub cell_diameters: f64,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One measured configuration.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BenchRow {
+    /// Balls.
+    pub balls: usize,
+    /// Area fraction.
+    pub area_fraction: f64,
+    /// Physical events run.
+    pub events: u64,
+    /// Setup seconds (generation and first predictions).
+    pub setup_seconds: f64,
+    /// Event-loop seconds.
+    pub seconds: f64,
+    /// Events per second in the loop.
+    pub events_per_second: f64,
+    /// Nanoseconds per event in the loop.
+    pub ns_per_event: f64,
+    /// Resident memory of the process after the run (MiB).
+    pub rss_mib: f64,
+}
+
+/// A line describing this machine: processor model, logical cores, OS.
+pub fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown processor".into());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    format!(
+        "{cpu}, {cores} logical cores, {} {}",
+        std::env::consts::OS,
+        std::env::consts::ARCH
+    )
+}
+
+/// Resident set size of this process in MiB (Linux), or 0 where unknown.
+pub fn rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmRSS:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<f64>().ok())
+        })
+        .map_or(0.0, |kb| kb / 1024.0)
+}
+
+/// Measures one configuration.
+pub fn measure(
+    balls: usize,
+    area_fraction: f64,
+    events: u64,
+    cell_diameters: f64,
+) -> Result<BenchRow, String> {
+    let k = ((balls as f64).sqrt().round() as usize).max(1);
+    let start = Instant::now();
+    let params = Params {
+        balls: Some(k * k),
+        seed: Some(1),
+        area_fraction: Some(area_fraction),
+        ..Params::default()
+    };
+    let scenario =
+        builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
+    let mut engine = EventList::new(&scenario, Options { cell_diameters });
+    let setup = start.elapsed().as_secs_f64();
+    let target = events.max(5 * (k * k) as u64);
+    let start = Instant::now();
+    let out = engine
+        .run_for(f64::INFINITY, target, &mut Ignore)
+        .map_err(|e| e.to_string())?;
+    let secs = start.elapsed().as_secs_f64();
+    let n = out.events.total();
+    Ok(BenchRow {
+        balls: k * k,
+        area_fraction,
+        events: n,
+        setup_seconds: setup,
+        seconds: secs,
+        events_per_second: n as f64 / secs,
+        ns_per_event: secs * 1e9 / n.max(1) as f64,
+        rss_mib: rss_mib(),
+    })
+}
+
+/// Runs `poolsim bench` and prints its table (or JSON).
+pub fn run(a: &BenchArgs) -> Result<(), String> {
+    for &phi in &a.area_fractions {
+        if !(phi > 0.0 && phi < 1.0) {
+            return Err(format!("--area-fractions: each must lie in (0, 1), got {phi}"));
+        }
+    }
+    let m = machine();
+    if !a.json {
+        println!("event-list engine, thesis gas (seed 1), one thread; {m}");
+        println!(
+            "{:>9} {:>6} {:>11} {:>9} {:>9} {:>14} {:>9} {:>9}",
+            "balls", "phi", "events", "setup s", "loop s", "events/s", "ns/event", "RSS MiB"
+        );
+    }
+    let mut rows = Vec::new();
+    for &n in &a.balls {
+        for &phi in &a.area_fractions {
+            let r = measure(n, phi, a.events, a.cell_diameters)?;
+            if !a.json {
+                println!(
+                    "{:>9} {:>6.2} {:>11} {:>9.2} {:>9.2} {:>14.0} {:>9.1} {:>9.0}",
+                    r.balls,
+                    r.area_fraction,
+                    r.events,
+                    r.setup_seconds,
+                    r.seconds,
+                    r.events_per_second,
+                    r.ns_per_event,
+                    r.rss_mib
+                );
+            }
+            rows.push(r);
+        }
+    }
+    if a.json {
+        println!("{}", json!({"machine": m, "engine": "event-list", "rows": rows}));
+    }
+    Ok(())
+}

@@ -1,0 +1,160 @@
+//! Invariants checked while a run goes (`poolsim run --check`): no two balls overlap, every ball
+//! is on the table or in a pocket, and kinetic energy is conserved where every elasticity is 1.
+//!
+//! After each event the balls it involved are checked against their neighbours and the cushions;
+//! every `n` events (n = the number of balls) the whole table is swept and the energy summed
+//! afresh, so the cost stays O(1) per event on average.
+
+use crate::engine::{BallState, Event, Observer, RunError, World};
+use crate::physics::kinetic_energy;
+
+/// Largest overlap allowed between two balls, or a ball and a cushion, as a fraction of a radius.
+pub const OVERLAP_TOLERANCE: f64 = 1e-9;
+
+/// Largest relative drift of kinetic energy allowed on an elastic table.
+pub const ENERGY_TOLERANCE: f64 = 1e-9;
+
+/// The invariant checker, an [`Observer`].
+pub struct Checker {
+    energy: Vec<f64>,
+    total: f64,
+    initial: f64,
+    elastic: bool,
+    since_sweep: usize,
+    /// The largest relative energy drift seen at a sweep.
+    pub max_energy_drift: f64,
+    /// Full sweeps done.
+    pub sweeps: u64,
+}
+
+/// Energy a ball carries: on the table, or into its pocket.
+fn ball_energy(b: &BallState) -> f64 {
+    kinetic_energy(b.mass, b.traj.velocity)
+}
+
+impl Checker {
+    /// A checker for balls starting in `balls`, on a table whose elasticities are all 1 when
+    /// `elastic`.
+    pub fn new(balls: &[BallState], elastic: bool) -> Checker {
+        let energy: Vec<f64> = balls.iter().map(ball_energy).collect();
+        let total = energy.iter().sum();
+        Checker {
+            energy,
+            total,
+            initial: total,
+            elastic,
+            since_sweep: 0,
+            max_energy_drift: 0.0,
+            sweeps: 0,
+        }
+    }
+
+    fn check_ball(world: &dyn World, i: u32, t: f64) -> Result<(), RunError> {
+        let balls = world.balls();
+        let bi = &balls[i as usize];
+        if bi.pocket.is_some() {
+            return Ok(());
+        }
+        let table = world.table();
+        let p = bi.traj.at(t);
+        let mut err = None;
+        world.for_each_neighbor(i, &mut |j| {
+            let bj = &balls[j as usize];
+            if err.is_some() || bj.pocket.is_some() {
+                return;
+            }
+            let overlap = bi.radius + bj.radius - (bj.traj.at(t) - p).norm();
+            if overlap > OVERLAP_TOLERANCE * bi.radius.min(bj.radius) {
+                let (a, b) = (i.min(j), i.max(j));
+                err = Some(format!(
+                    "t = {t}: Ball-{} and Ball-{} overlap by {overlap:e} ({:e} of a radius)",
+                    a + 1,
+                    b + 1,
+                    overlap / bi.radius.min(bj.radius)
+                ));
+            }
+        });
+        if let Some(e) = err {
+            return Err(RunError::Violation(e));
+        }
+        let slack = OVERLAP_TOLERANCE * bi.radius;
+        if p.x < table.lo.x - slack
+            || p.y < table.lo.y - slack
+            || p.x > table.hi.x + slack
+            || p.y > table.hi.y + slack
+        {
+            return Err(RunError::Violation(format!(
+                "t = {t}: Ball-{} at [{}, {}] has left the table",
+                i + 1,
+                p.x,
+                p.y
+            )));
+        }
+        for (k, &(from, to, _)) in table.cushions.iter().enumerate() {
+            let l = to - from;
+            let len = l.norm();
+            let along = (p - from).dot(l) / len;
+            let into = (p - from).dot(l.perp_cw()) / len;
+            if along >= 0.0 && along <= len && into.abs() < bi.radius - slack {
+                return Err(RunError::Violation(format!(
+                    "t = {t}: Ball-{} overlaps Cushion-{} by {:e}",
+                    i + 1,
+                    k + 1,
+                    bi.radius - into.abs()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the whole table at time `t` and the energy sum.
+    pub fn sweep(&mut self, world: &dyn World, t: f64) -> Result<(), RunError> {
+        self.sweeps += 1;
+        self.since_sweep = 0;
+        let balls = world.balls();
+        for i in 0..balls.len() as u32 {
+            Self::check_ball(world, i, t)?;
+        }
+        for (e, b) in self.energy.iter_mut().zip(balls) {
+            *e = ball_energy(b);
+        }
+        self.total = self.energy.iter().sum();
+        self.check_energy(t)
+    }
+
+    fn check_energy(&mut self, t: f64) -> Result<(), RunError> {
+        if !self.elastic || self.initial == 0.0 {
+            return Ok(());
+        }
+        let drift = ((self.total - self.initial) / self.initial).abs();
+        self.max_energy_drift = self.max_energy_drift.max(drift);
+        if drift > ENERGY_TOLERANCE {
+            return Err(RunError::Violation(format!(
+                "t = {t}: kinetic energy {} differs from the initial {} by {drift:e} relative",
+                self.total, self.initial
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl Observer for Checker {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
+        let balls = world.balls();
+        let n_balls = balls.len() as u32;
+        for i in [ev.a, ev.b] {
+            if i < n_balls {
+                Self::check_ball(world, i, ev.t)?;
+                let e = ball_energy(&balls[i as usize]);
+                self.total += e - self.energy[i as usize];
+                self.energy[i as usize] = e;
+            }
+        }
+        self.check_energy(ev.t)?;
+        self.since_sweep += 1;
+        if self.since_sweep >= balls.len().max(1) {
+            self.sweep(world, ev.t)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,236 @@
+//! A uniform cell grid over the table, so that an event costs a bounded number of pair tests.
+//!
+//! Cells are at least a ball diameter wide (with a small margin), and a ball belongs to the cell
+//! holding its centre, so any two touching balls sit in the same or adjacent cells. The outermost
+//! cells reach out to infinity: a ball that leaves the table's box stays in its edge cell and the
+//! neighbourhood rule still holds. Balls of a cell form an intrusive doubly linked list (no
+//! allocation per cell, O(1) moves); fixed objects are listed once per cell they may reach, in
+//! compressed rows.
+
+use super::Table;
+use crate::geometry::Vec2;
+
+const NIL: u32 = u32::MAX;
+
+/// Cells are at least this factor times the largest diameter wide. The margin guarantees that two
+/// balls that become neighbours when one of them crosses a cell boundary are strictly apart, so a
+/// crossing never uncovers an immediate collision.
+const CELL_MARGIN: f64 = 1.0 + 1e-6;
+
+/// The cell grid: geometry, per-cell ball lists and per-cell fixed-object lists.
+#[derive(Clone, Debug)]
+pub struct Grid {
+    lo: Vec2,
+    width: f64,
+    height: f64,
+    nx: u32,
+    ny: u32,
+    head: Vec<u32>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    cell_of: Vec<u32>,
+    fixed_start: Vec<u32>,
+    fixed_items: Vec<u32>,
+}
+
+impl Grid {
+    /// Builds a grid for `table` with balls of radius at most `rmax`, `n` balls and the given
+    /// minimum cell width (at least a diameter; larger means fewer crossings, more pair tests).
+    /// The number of cells is capped near `4 n` so that memory stays linear in the ball count.
+    pub fn new(table: &Table, n: usize, rmax: f64, min_cell: f64) -> Grid {
+        let span = table.hi - table.lo;
+        let w_min = (2.0 * rmax * CELL_MARGIN).max(min_cell);
+        let cap = (4 * n).max(16) as f64;
+        let mut nx = ((span.x / w_min).floor().max(1.0)).min(1e6);
+        let mut ny = ((span.y / w_min).floor().max(1.0)).min(1e6);
+        while nx * ny > cap {
+            nx = (nx / 2.0).floor().max(1.0);
+            ny = (ny / 2.0).floor().max(1.0);
+        }
+        let (nx, ny) = (nx as u32, ny as u32);
+        let mut g = Grid {
+            lo: table.lo,
+            width: span.x / f64::from(nx),
+            height: span.y / f64::from(ny),
+            nx,
+            ny,
+            head: vec![NIL; (nx * ny) as usize],
+            next: vec![NIL; n],
+            prev: vec![NIL; n],
+            cell_of: vec![NIL; n],
+            fixed_start: Vec::new(),
+            fixed_items: Vec::new(),
+        };
+        if !(g.width > 0.0) || !(g.height > 0.0) {
+            g.width = w_min;
+            g.height = w_min;
+        }
+        g.index_fixed(table, rmax);
+        g
+    }
+
+    fn index_fixed(&mut self, table: &Table, rmax: f64) {
+        let reach2 = (rmax * 1.01 + 1e-9 * (self.width + self.height)).powi(2);
+        let first = table.n_balls;
+        let ids: Vec<u32> = (first..first + table.n_fixed()).collect();
+        self.fixed_start.push(0);
+        for c in 0..self.nx * self.ny {
+            let (lo, hi) = self.cell_rect(c);
+            for &id in &ids {
+                if table.distance2_to_rect(id, lo, hi) <= reach2 {
+                    self.fixed_items.push(id);
+                }
+            }
+            self.fixed_start.push(self.fixed_items.len() as u32);
+        }
+    }
+
+    /// The rectangle of cell `c`, with outer cells extended to infinity.
+    fn cell_rect(&self, c: u32) -> (Vec2, Vec2) {
+        let (cx, cy) = (c % self.nx, c / self.nx);
+        let x0 = if cx == 0 {
+            f64::NEG_INFINITY
+        } else {
+            self.lo.x + f64::from(cx) * self.width
+        };
+        let x1 = if cx + 1 == self.nx {
+            f64::INFINITY
+        } else {
+            self.lo.x + f64::from(cx + 1) * self.width
+        };
+        let y0 = if cy == 0 {
+            f64::NEG_INFINITY
+        } else {
+            self.lo.y + f64::from(cy) * self.height
+        };
+        let y1 = if cy + 1 == self.ny {
+            f64::INFINITY
+        } else {
+            self.lo.y + f64::from(cy + 1) * self.height
+        };
+        (Vec2::new(x0, y0), Vec2::new(x1, y1))
+    }
+
+    /// Number of cells along x and y.
+    pub fn dims(&self) -> (u32, u32) {
+        (self.nx, self.ny)
+    }
+
+    /// The cell holding point `p` (clamped to the grid).
+    #[inline]
+    pub fn cell_at(&self, p: Vec2) -> u32 {
+        let cx = ((p.x - self.lo.x) / self.width).floor();
+        let cy = ((p.y - self.lo.y) / self.height).floor();
+        let cx = cx.clamp(0.0, f64::from(self.nx - 1)) as u32;
+        let cy = cy.clamp(0.0, f64::from(self.ny - 1)) as u32;
+        cy * self.nx + cx
+    }
+
+    /// The cell ball `i` is in, or `None` if it was removed.
+    #[inline]
+    pub fn cell_of(&self, i: u32) -> Option<u32> {
+        let c = self.cell_of[i as usize];
+        (c != NIL).then_some(c)
+    }
+
+    /// Puts ball `i` into cell `c`.
+    #[inline]
+    pub fn insert(&mut self, i: u32, c: u32) {
+        let h = self.head[c as usize];
+        self.next[i as usize] = h;
+        self.prev[i as usize] = NIL;
+        if h != NIL {
+            self.prev[h as usize] = i;
+        }
+        self.head[c as usize] = i;
+        self.cell_of[i as usize] = c;
+    }
+
+    /// Takes ball `i` out of its cell.
+    #[inline]
+    pub fn remove(&mut self, i: u32) {
+        let c = self.cell_of[i as usize];
+        if c == NIL {
+            return;
+        }
+        let (p, n) = (self.prev[i as usize], self.next[i as usize]);
+        if p == NIL {
+            self.head[c as usize] = n;
+        } else {
+            self.next[p as usize] = n;
+        }
+        if n != NIL {
+            self.prev[n as usize] = p;
+        }
+        self.cell_of[i as usize] = NIL;
+    }
+
+    /// Calls `f` with every ball in the 3 × 3 block of cells around cell `c` (including any ball
+    /// in `c` itself).
+    #[inline]
+    pub fn for_each_near(&self, c: u32, mut f: impl FnMut(u32)) {
+        let (cx, cy) = (c % self.nx, c / self.nx);
+        let x0 = cx.saturating_sub(1);
+        let x1 = (cx + 1).min(self.nx - 1);
+        let y0 = cy.saturating_sub(1);
+        let y1 = (cy + 1).min(self.ny - 1);
+        for y in y0..=y1 {
+            let row = y * self.nx;
+            for x in x0..=x1 {
+                let mut j = self.head[(row + x) as usize];
+                while j != NIL {
+                    f(j);
+                    j = self.next[j as usize];
+                }
+            }
+        }
+    }
+
+    /// The fixed objects a ball whose centre is in cell `c` may touch before it leaves the cell.
+    #[inline]
+    pub fn fixed_near(&self, c: u32) -> &[u32] {
+        let (a, b) = (
+            self.fixed_start[c as usize] as usize,
+            self.fixed_start[c as usize + 1] as usize,
+        );
+        &self.fixed_items[a..b]
+    }
+
+    /// When a centre moving along `position + (t - t0) velocity` leaves cell `c`, and the cell it
+    /// enters; `None` if it never leaves (at rest, or heading out through an outer cell).
+    #[inline]
+    pub fn exit(&self, c: u32, position: Vec2, velocity: Vec2, t0: f64) -> Option<(f64, u32)> {
+        let (cx, cy) = (c % self.nx, c / self.nx);
+        let mut best: Option<(f64, u32)> = None;
+        if velocity.x > 0.0 && cx + 1 < self.nx {
+            let b = self.lo.x + f64::from(cx + 1) * self.width;
+            best = Some((t0 + (b - position.x) / velocity.x, c + 1));
+        } else if velocity.x < 0.0 && cx > 0 {
+            let b = self.lo.x + f64::from(cx) * self.width;
+            best = Some((t0 + (b - position.x) / velocity.x, c - 1));
+        }
+        let y = if velocity.y > 0.0 && cy + 1 < self.ny {
+            let b = self.lo.y + f64::from(cy + 1) * self.height;
+            Some((t0 + (b - position.y) / velocity.y, c + self.nx))
+        } else if velocity.y < 0.0 && cy > 0 {
+            let b = self.lo.y + f64::from(cy) * self.height;
+            Some((t0 + (b - position.y) / velocity.y, c - self.nx))
+        } else {
+            None
+        };
+        match (best, y) {
+            (Some(a), Some(b)) => Some(if b.0 < a.0 { b } else { a }),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// Bytes of memory the grid holds.
+    pub fn memory_bytes(&self) -> usize {
+        4 * (self.head.len()
+            + self.next.len()
+            + self.prev.len()
+            + self.cell_of.len()
+            + self.fixed_start.len()
+            + self.fixed_items.len())
+    }
+}

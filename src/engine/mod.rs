@@ -1,0 +1,385 @@
+//! Engines: the event-list engine (thesis fig. 2), the reference every other engine is checked
+//! against, and the time-step engine (fig. 1), the baseline the thesis argues against.
+//!
+//! Every engine reads a validated [`Scenario`], turns it into a [`Table`] (the fixed objects and
+//! the numbering of all objects) and a vector of [`BallState`]s, and reports each physical event it
+//! executes, in execution order, to an [`Observer`]. Engines write no files: sinks do.
+
+pub mod event_list;
+pub mod grid;
+pub mod time_step;
+
+use crate::geometry::{Trajectory, Vec2};
+use crate::physics::{self, Contact};
+use crate::scenario::Scenario;
+use std::fmt;
+
+/// What kind of physical event happened; the names are the trace's `kind` strings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum EventKind {
+    /// Two balls collided.
+    BallBall,
+    /// A ball bounced off a cushion.
+    BallCushion,
+    /// A ball bounced off a pocket's corner.
+    BallCorner,
+    /// A ball's centre crossed a pocket line: the ball dropped in.
+    BallPocket,
+}
+
+impl EventKind {
+    /// Every kind, in the order summaries list them.
+    pub const ALL: [EventKind; 4] = [
+        EventKind::BallBall,
+        EventKind::BallCushion,
+        EventKind::BallCorner,
+        EventKind::BallPocket,
+    ];
+
+    /// The trace name: `ball-ball`, `ball-cushion`, `ball-corner` or `ball-pocket`.
+    pub fn name(self) -> &'static str {
+        match self {
+            EventKind::BallBall => "ball-ball",
+            EventKind::BallCushion => "ball-cushion",
+            EventKind::BallCorner => "ball-corner",
+            EventKind::BallPocket => "ball-pocket",
+        }
+    }
+}
+
+/// One executed physical event. Objects are global indices (see [`Table`]); `a < b` always, and
+/// `a` is a ball.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Event {
+    /// Simulation time of the event.
+    pub t: f64,
+    /// What happened.
+    pub kind: EventKind,
+    /// The lower object index: always a ball.
+    pub a: u32,
+    /// The higher object index: a ball, cushion, pocket or corner.
+    pub b: u32,
+}
+
+/// A fixed object of the table, by its index within its own kind (0-based).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fixed {
+    /// Cushion `k` (`Cushion-{k+1}`).
+    Cushion(u32),
+    /// Pocket `k` (`Pocket-{k+1}`).
+    Pocket(u32),
+    /// Corner `k` (`Corner-{k+1}`), an end of pocket `k / 2`.
+    Corner(u32),
+}
+
+/// The fixed objects of a table and the global numbering of every object: balls first
+/// (`0..n_balls`), then cushions, pockets and corners, each in scenario order.
+#[derive(Clone, Debug)]
+pub struct Table {
+    /// Number of balls.
+    pub n_balls: u32,
+    /// Cushion ends and elasticities.
+    pub cushions: Vec<(Vec2, Vec2, f64)>,
+    /// Pocket line ends.
+    pub pockets: Vec<(Vec2, Vec2)>,
+    /// Corner positions and elasticities.
+    pub corners: Vec<(Vec2, f64)>,
+    /// Lower-left corner of the table's bounding box.
+    pub lo: Vec2,
+    /// Upper-right corner of the table's bounding box.
+    pub hi: Vec2,
+}
+
+impl Table {
+    /// Builds the table of a validated scenario.
+    pub fn new(s: &Scenario) -> Table {
+        let (lo, hi) = s.bounds();
+        Table {
+            n_balls: s.balls.len() as u32,
+            cushions: s
+                .cushions
+                .iter()
+                .map(|c| (c.from, c.to, c.elasticity))
+                .collect(),
+            pockets: s.pockets.iter().map(|p| (p.from, p.to)).collect(),
+            corners: (0..s.corner_count())
+                .map(|k| {
+                    (
+                        s.corner_position(k),
+                        s.pockets[k / 2].corner_elasticity,
+                    )
+                })
+                .collect(),
+            lo,
+            hi,
+        }
+    }
+
+    /// Number of fixed objects.
+    pub fn n_fixed(&self) -> u32 {
+        (self.cushions.len() + self.pockets.len() + self.corners.len()) as u32
+    }
+
+    /// The fixed object with global index `id` (which must not be a ball).
+    #[inline]
+    pub fn fixed(&self, id: u32) -> Fixed {
+        let k = id - self.n_balls;
+        let nc = self.cushions.len() as u32;
+        let np = self.pockets.len() as u32;
+        if k < nc {
+            Fixed::Cushion(k)
+        } else if k < nc + np {
+            Fixed::Pocket(k - nc)
+        } else {
+            Fixed::Corner(k - nc - np)
+        }
+    }
+
+    /// The global index of a fixed object.
+    pub fn fixed_id(&self, f: Fixed) -> u32 {
+        let nc = self.cushions.len() as u32;
+        let np = self.pockets.len() as u32;
+        self.n_balls
+            + match f {
+                Fixed::Cushion(k) => k,
+                Fixed::Pocket(k) => nc + k,
+                Fixed::Corner(k) => nc + np + k,
+            }
+    }
+
+    /// The name of object `id`: `Ball-3`, `Cushion-1`, `Pocket-2`, `Corner-4`.
+    pub fn name(&self, id: u32) -> String {
+        if id < self.n_balls {
+            return format!("Ball-{}", id + 1);
+        }
+        match self.fixed(id) {
+            Fixed::Cushion(k) => format!("Cushion-{}", k + 1),
+            Fixed::Pocket(k) => format!("Pocket-{}", k + 1),
+            Fixed::Corner(k) => format!("Corner-{}", k + 1),
+        }
+    }
+
+    /// When a ball on trajectory `tr` with radius `r` meets fixed object `id`.
+    #[inline]
+    pub fn contact(&self, id: u32, tr: &Trajectory, r: f64) -> Contact {
+        match self.fixed(id) {
+            Fixed::Cushion(k) => {
+                let (from, to, _) = self.cushions[k as usize];
+                physics::ball_face_contact(tr, r, from, to)
+            }
+            Fixed::Pocket(k) => {
+                let (from, to) = self.pockets[k as usize];
+                physics::ball_face_contact(tr, 0.0, from, to)
+            }
+            Fixed::Corner(k) => physics::ball_corner_contact(tr, r, self.corners[k as usize].0),
+        }
+    }
+
+    /// The kind of event a ball has with fixed object `id`.
+    pub fn event_kind(&self, id: u32) -> EventKind {
+        match self.fixed(id) {
+            Fixed::Cushion(_) => EventKind::BallCushion,
+            Fixed::Pocket(_) => EventKind::BallPocket,
+            Fixed::Corner(_) => EventKind::BallCorner,
+        }
+    }
+
+    /// The velocity after a ball at `p` with velocity `v` bounces off fixed object `id`, or `None`
+    /// if the object is a pocket (the ball drops in).
+    pub fn bounce(&self, id: u32, p: Vec2, v: Vec2) -> Option<Vec2> {
+        match self.fixed(id) {
+            Fixed::Cushion(k) => {
+                let (from, to, e) = self.cushions[k as usize];
+                Some(physics::cushion_velocity(v, from, to, e))
+            }
+            Fixed::Pocket(_) => None,
+            Fixed::Corner(k) => {
+                let (c, e) = self.corners[k as usize];
+                Some(physics::corner_velocity(v, p, c, e))
+            }
+        }
+    }
+
+    /// The squared distance from fixed object `id` to the rectangle `[lo, hi]`.
+    pub fn distance2_to_rect(&self, id: u32, lo: Vec2, hi: Vec2) -> f64 {
+        use crate::geometry::{rect_distance2, segment_rect_distance2};
+        match self.fixed(id) {
+            Fixed::Cushion(k) => {
+                let (a, b, _) = self.cushions[k as usize];
+                segment_rect_distance2(a, b, lo, hi)
+            }
+            Fixed::Pocket(k) => {
+                let (a, b) = self.pockets[k as usize];
+                segment_rect_distance2(a, b, lo, hi)
+            }
+            Fixed::Corner(k) => rect_distance2(self.corners[k as usize].0, lo, hi),
+        }
+    }
+
+    /// Whether every elasticity on the table is 1, so kinetic energy must be conserved.
+    pub fn is_elastic(&self) -> bool {
+        self.cushions.iter().all(|c| c.2 == 1.0) && self.corners.iter().all(|c| c.1 == 1.0)
+    }
+}
+
+/// The state of one ball: its trajectory since its last velocity change, size and mass, and the
+/// pocket it dropped into, if any (then `traj` holds where and how it crossed the pocket line).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BallState {
+    /// Trajectory since the last velocity change.
+    pub traj: Trajectory,
+    /// Radius (length).
+    pub radius: f64,
+    /// Mass.
+    pub mass: f64,
+    /// The pocket (0-based) the ball dropped into.
+    pub pocket: Option<u32>,
+}
+
+impl BallState {
+    /// The initial states of a scenario's balls, fixed at time 0.
+    pub fn initial(s: &Scenario) -> Vec<BallState> {
+        s.balls
+            .iter()
+            .map(|b| BallState {
+                traj: Trajectory {
+                    position: b.position,
+                    velocity: b.velocity,
+                    t0: 0.0,
+                },
+                radius: b.radius,
+                mass: b.mass,
+                pocket: None,
+            })
+            .collect()
+    }
+
+    /// Position at time `t`: on its trajectory, or where it entered its pocket.
+    #[inline]
+    pub fn position(&self, t: f64) -> Vec2 {
+        if self.pocket.is_some() {
+            self.traj.position
+        } else {
+            self.traj.at(t)
+        }
+    }
+
+    /// Velocity on the table (zero in a pocket).
+    #[inline]
+    pub fn velocity(&self) -> Vec2 {
+        if self.pocket.is_some() {
+            Vec2::ZERO
+        } else {
+            self.traj.velocity
+        }
+    }
+}
+
+/// A read-only view of an engine's state between events, for invariant checks.
+pub trait World {
+    /// The table.
+    fn table(&self) -> &Table;
+    /// Every ball's state.
+    fn balls(&self) -> &[BallState];
+    /// Calls `f` with every ball that might touch ball `i` now (a superset is fine).
+    fn for_each_neighbor(&self, i: u32, f: &mut dyn FnMut(u32));
+}
+
+/// Receives every executed physical event, in execution order, with the state just after it.
+pub trait Observer {
+    /// Called after each event; an error stops the run.
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError>;
+}
+
+/// An observer that ignores everything.
+pub struct Ignore;
+
+impl Observer for Ignore {
+    fn on_event(&mut self, _: &Event, _: &dyn World) -> Result<(), RunError> {
+        Ok(())
+    }
+}
+
+/// Observers chained: each sees every event in turn.
+impl<A: Observer, B: Observer> Observer for (A, B) {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
+        self.0.on_event(ev, world)?;
+        self.1.on_event(ev, world)
+    }
+}
+
+impl<O: Observer + ?Sized> Observer for &mut O {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
+        (**self).on_event(ev, world)
+    }
+}
+
+/// Why a run stopped before its end time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunError {
+    /// An invariant was violated (`--check`): what, where and when.
+    Violation(String),
+    /// One instant had more events than the cap: a cascade that does not end.
+    Cascade {
+        /// The instant.
+        t: f64,
+        /// Events processed at it.
+        events: u64,
+    },
+    /// An observer's output failed (a trace file could not be written).
+    Output(String),
+}
+
+impl fmt::Display for RunError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RunError::Violation(m) => write!(f, "check failed: {m}"),
+            RunError::Cascade { t, events } => write!(
+                f,
+                "more than {events} events at the single instant t = {t}: a cascade of \
+                 instantaneous collisions that does not end"
+            ),
+            RunError::Output(m) => write!(f, "output failed: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for RunError {}
+
+/// Counts of executed events by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EventCounts {
+    /// Counts indexed like [`EventKind::ALL`].
+    pub by_kind: [u64; 4],
+}
+
+impl EventCounts {
+    /// Adds one event of `kind`.
+    #[inline]
+    pub fn add(&mut self, kind: EventKind) {
+        self.by_kind[kind as usize] += 1;
+    }
+
+    /// The count of `kind`.
+    pub fn get(&self, kind: EventKind) -> u64 {
+        self.by_kind[kind as usize]
+    }
+
+    /// All events.
+    pub fn total(&self) -> u64 {
+        self.by_kind.iter().sum()
+    }
+}
+
+/// The end of a run: the balls at the end time and what the engine counted.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The end time.
+    pub t: f64,
+    /// Every ball's state, fixed at `t` (balls in pockets keep their entry fix).
+    pub balls: Vec<BallState>,
+    /// Executed physical events by kind.
+    pub events: EventCounts,
+    /// Engine-specific counters, by name, for the run summary.
+    pub engine_stats: Vec<(&'static str, f64)>,
+}

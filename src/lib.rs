@@ -1,0 +1,20 @@
+//! poolsim: exact event-driven simulation of pool balls and hard disks, after A. P. Goldberg,
+//! "Object-Oriented Simulation of Pool Ball Motion" (M.S. thesis, UCLA, 1984).
+//!
+//! The crate is a few rooms, each with one job:
+//! - [`geometry`] and [`physics`]: pure functions of trajectories (thesis ch. 3);
+//! - [`scenario`]: tables and balls from TOML or built-in generators, validated once;
+//! - [`vtime`]: the lexicographic virtual time that orders simultaneous events exactly;
+//! - [`engine`]: the event-list and time-step engines;
+//! - [`check`]: invariants checked while a run goes (`--check`);
+//! - [`output`]: the trace, final state and run summary.
+
+pub mod bench;
+pub mod check;
+pub mod engine;
+pub mod geometry;
+pub mod output;
+pub mod physics;
+pub mod run;
+pub mod scenario;
+pub mod vtime;

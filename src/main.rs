@@ -1,0 +1,345 @@
+//! `poolsim`: the command line over the library. Parses arguments, loads the scenario, runs the
+//! pipeline of `poolsim::run`, writes the outputs. Exit status: 0 done, 2 bad input or usage,
+//! 1 internal failure or a failed `--check`.
+
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use poolsim::engine::{Event, Observer, RunError, World};
+use poolsim::output::{FinalState, TraceWriter};
+use poolsim::run::{execute, EngineKind, RunConfig};
+use poolsim::scenario::{self, builtin, Scenario};
+use std::fs::File;
+use std::io::{BufWriter, IsTerminal};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "poolsim", version, about = "Exact event-driven simulation of pool balls and hard disks (after Goldberg, UCLA 1984)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Parameters of generated scenarios.
+#[derive(clap::Args, Clone, Debug, Default)]
+struct GenArgs {
+    /// Number of balls (gas: a square number).
+    #[arg(long)]
+    balls: Option<usize>,
+    /// Random seed of generated scenarios.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Fraction of the table's area covered by balls (gas).
+    #[arg(long = "area-fraction")]
+    area_fraction: Option<f64>,
+    /// Ball radius (gas).
+    #[arg(long)]
+    radius: Option<f64>,
+    /// Speeds are drawn uniform in [0, V) (gas, reversal).
+    #[arg(long = "speed-max")]
+    speed_max: Option<f64>,
+}
+
+impl GenArgs {
+    fn params(&self) -> builtin::Params {
+        builtin::Params {
+            balls: self.balls,
+            seed: self.seed,
+            area_fraction: self.area_fraction,
+            radius: self.radius,
+            speed_max: self.speed_max,
+        }
+    }
+}
+
+#[derive(clap::Args, Clone, Debug)]
+struct RunArgs {
+    /// A built-in scenario name (see `poolsim scenarios`) or a TOML file.
+    scenario: String,
+    /// event-list, time-step (objects and time-warp come with their issues).
+    #[arg(long, default_value = "event-list")]
+    engine: String,
+    /// Sector layout: none, auto, N or NxM (sectored engines only).
+    #[arg(long)]
+    sectors: Option<String>,
+    /// End time (default: the scenario's).
+    #[arg(long, allow_negative_numbers = true)]
+    until: Option<f64>,
+    #[command(flatten)]
+    gen: GenArgs,
+    /// Write the trace (JSON Lines, one line per physical event) here.
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    /// Write the final state (JSON) here.
+    #[arg(long = "final-state")]
+    final_state: Option<PathBuf>,
+    /// Print the run summary as one JSON object on stdout, and nothing else there.
+    #[arg(long)]
+    json: bool,
+    /// Check invariants at every event; a violation stops the run with exit status 1.
+    #[arg(long)]
+    check: bool,
+    /// Worker threads (time-warp engine).
+    #[arg(long)]
+    workers: Option<usize>,
+    /// Delay of NewVelocity messages (objects engines).
+    #[arg(long = "newvelocity-delay")]
+    newvelocity_delay: Option<String>,
+    /// Time step of the time-step engine.
+    #[arg(long, allow_negative_numbers = true)]
+    dt: Option<f64>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the built-in scenarios.
+    Scenarios,
+    /// Run a scenario.
+    Run(RunArgs),
+    /// The main job: run the thesis' 36-ball gas with checks on and print the summary.
+    Demo {
+        /// Print the summary as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Measure events per second over ball counts and densities.
+    Bench(poolsim::bench::BenchArgs),
+}
+
+/// A failure with its exit status.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+fn usage(message: impl Into<String>) -> Failure {
+    Failure {
+        code: 2,
+        message: message.into(),
+    }
+}
+
+fn internal(message: impl Into<String>) -> Failure {
+    Failure {
+        code: 1,
+        message: message.into(),
+    }
+}
+
+/// Shows progress in simulated time on stderr.
+struct Progress {
+    bar: ProgressBar,
+    until: f64,
+    seen: u64,
+}
+
+impl Progress {
+    fn new(until: f64, quiet: bool) -> Option<Progress> {
+        if quiet || !std::io::stderr().is_terminal() || !(until > 0.0) {
+            return None;
+        }
+        let bar = ProgressBar::new(1000);
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}")
+                .expect("a valid template"),
+        );
+        Some(Progress {
+            bar,
+            until,
+            seen: 0,
+        })
+    }
+}
+
+impl Observer for Progress {
+    fn on_event(&mut self, ev: &Event, _: &dyn World) -> Result<(), RunError> {
+        self.seen += 1;
+        if self.seen % 8192 == 0 {
+            self.bar
+                .set_position((ev.t / self.until * 1000.0).clamp(0.0, 1000.0) as u64);
+            self.bar
+                .set_message(format!("t = {:.3} / {}, {} events", ev.t, self.until, self.seen));
+        }
+        Ok(())
+    }
+}
+
+fn load(spec: &str, gen: &GenArgs) -> Result<Scenario, Failure> {
+    scenario::load(spec, &gen.params()).map_err(|e| usage(e.to_string()))
+}
+
+fn engine_of(a: &RunArgs) -> Result<EngineKind, Failure> {
+    match a.engine.as_str() {
+        "event-list" => {
+            if let Some(flag) = a.dt.map(|_| "--dt") {
+                return Err(usage(format!("{flag}: only the time-step engine takes it")));
+            }
+            Ok(EngineKind::EventList)
+        }
+        "time-step" => {
+            let dt = a
+                .dt
+                .ok_or_else(|| usage("--dt: the time-step engine needs a time step"))?;
+            if !(dt.is_finite() && dt > 0.0) {
+                return Err(usage(format!("--dt: must be a positive number, got {dt}")));
+            }
+            Ok(EngineKind::TimeStep { dt })
+        }
+        "objects" | "time-warp" => Err(usage(format!(
+            "--engine: `{}` is not built yet; available: event-list, time-step",
+            a.engine
+        ))),
+        other => Err(usage(format!(
+            "--engine: unknown engine `{other}`; available: event-list, time-step"
+        ))),
+    }
+}
+
+fn run(a: &RunArgs) -> Result<(), Failure> {
+    let engine = engine_of(a)?;
+    for (flag, given) in [
+        ("--sectors", a.sectors.is_some()),
+        ("--workers", a.workers.is_some()),
+        ("--newvelocity-delay", a.newvelocity_delay.is_some()),
+    ] {
+        if given {
+            return Err(usage(format!(
+                "{flag}: only the objects and time-warp engines take it, and they are not built yet"
+            )));
+        }
+    }
+    let scenario = load(&a.scenario, &a.gen)?;
+    let until = a.until.unwrap_or(scenario.until);
+    if !until.is_finite() || until < 0.0 {
+        return Err(usage(format!(
+            "--until: must be a finite number not below 0, got {until}"
+        )));
+    }
+    let cfg = RunConfig {
+        engine,
+        until,
+        check: a.check,
+    };
+    let mut trace = match &a.trace {
+        Some(p) => Some(TraceWriter::new(BufWriter::new(File::create(p).map_err(
+            |e| usage(format!("{}: cannot create the trace file: {e}", p.display())),
+        )?))),
+        None => None,
+    };
+    let mut progress = Progress::new(until, a.quiet);
+    let report = {
+        let mut sinks = Sinks {
+            trace: trace.as_mut(),
+            progress: progress.as_mut(),
+        };
+        execute(&scenario, &cfg, &mut sinks)
+    };
+    if let Some(p) = &progress {
+        p.bar.finish_and_clear();
+    }
+    if let Some(t) = trace {
+        t.finish()
+            .map_err(|e| internal(format!("writing the trace failed: {e}")))?;
+    }
+    let report = report.map_err(|e| internal(e.to_string()))?;
+    if let Some(p) = &a.final_state {
+        let fs = FinalState::new(report.outcome.t, &report.outcome.balls);
+        let text = serde_json::to_string_pretty(&fs).expect("a final state serializes");
+        std::fs::write(p, text + "\n")
+            .map_err(|e| usage(format!("{}: cannot write the final state: {e}", p.display())))?;
+    }
+    print_summary(&report.summary, a.json);
+    Ok(())
+}
+
+/// Trace and progress, each optional.
+struct Sinks<'a, W: std::io::Write> {
+    trace: Option<&'a mut TraceWriter<W>>,
+    progress: Option<&'a mut Progress>,
+}
+
+impl<W: std::io::Write> Observer for Sinks<'_, W> {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
+        if let Some(t) = &mut self.trace {
+            t.on_event(ev, world)?;
+        }
+        if let Some(p) = &mut self.progress {
+            p.on_event(ev, world)?;
+        }
+        Ok(())
+    }
+}
+
+fn print_summary(summary: &serde_json::Value, json: bool) {
+    if json {
+        println!("{summary}");
+        return;
+    }
+    let s = summary;
+    println!("scenario      {}", s["scenario"].as_str().unwrap_or(""));
+    println!("engine        {}", s["engine"].as_str().unwrap_or(""));
+    println!("balls         {}", s["balls"]);
+    println!("until         {}", s["until"]);
+    let ev = &s["events"];
+    println!(
+        "events        {} (ball-ball {}, ball-cushion {}, ball-corner {}, ball-pocket {})",
+        ev["total"], ev["ball-ball"], ev["ball-cushion"], ev["ball-corner"], ev["ball-pocket"]
+    );
+    let ke = &s["kinetic_energy"];
+    println!(
+        "energy        initial {}, final {} on the table + {} in pockets (relative drift {:e})",
+        ke["initial"],
+        ke["final"],
+        ke["pocketed"],
+        ke["relative_drift"].as_f64().unwrap_or(0.0)
+    );
+    println!("digest        {}", s["final_state_digest"].as_str().unwrap_or(""));
+    println!(
+        "wall          {:.3} s, {:.0} events/s{}",
+        s["wall_seconds"].as_f64().unwrap_or(0.0),
+        s["events_per_second"].as_f64().unwrap_or(0.0),
+        if s["checked"] == true {
+            ", invariants checked at every event"
+        } else {
+            ""
+        }
+    );
+}
+
+fn demo(json: bool) -> Result<(), Failure> {
+    let scenario = load("gas", &GenArgs::default())?;
+    let cfg = RunConfig {
+        engine: EngineKind::EventList,
+        until: scenario.until,
+        check: true,
+    };
+    let report = execute(&scenario, &cfg, &mut poolsim::engine::Ignore)
+        .map_err(|e| internal(e.to_string()))?;
+    print_summary(&report.summary, json);
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Scenarios => {
+            for (name, about) in builtin::list() {
+                println!("{name:<10} {about}");
+            }
+            Ok(())
+        }
+        Command::Run(a) => run(a),
+        Command::Demo { json } => demo(*json),
+        Command::Bench(b) => poolsim::bench::run(b).map_err(|e| usage(e)),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("poolsim: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}

@@ -1,0 +1,143 @@
+//! Sinks for what a run produces: the trace (JSON Lines), the final state (JSON), the bit-exact
+//! digest of the final state, and event counting. Formats are the contracts of DESIGN.md.
+
+use crate::engine::{BallState, Event, EventKind, Observer, RunError, Table, World};
+use serde::Serialize;
+use std::io::Write;
+
+/// One trace line, as written: `{"t": 1.25, "kind": "ball-ball", "objects": ["Ball-1", "Ball-2"]}`.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct TraceLine {
+    /// Time of the event.
+    pub t: f64,
+    /// `ball-ball`, `ball-cushion`, `ball-corner` or `ball-pocket`.
+    pub kind: String,
+    /// The two objects, lower index first.
+    pub objects: [String; 2],
+}
+
+impl TraceLine {
+    /// The trace line of an event on `table`.
+    pub fn new(ev: &Event, table: &Table) -> TraceLine {
+        TraceLine {
+            t: ev.t,
+            kind: ev.kind.name().to_string(),
+            objects: [table.name(ev.a), table.name(ev.b)],
+        }
+    }
+}
+
+/// Writes one JSON line per event to `out`.
+pub struct TraceWriter<W: Write> {
+    out: W,
+}
+
+impl<W: Write> TraceWriter<W> {
+    /// A trace writer over `out` (wrap files in a `BufWriter`).
+    pub fn new(out: W) -> TraceWriter<W> {
+        TraceWriter { out }
+    }
+
+    /// Flushes and returns the writer.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        self.out.flush()?;
+        Ok(self.out)
+    }
+}
+
+impl<W: Write> Observer for TraceWriter<W> {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
+        let line = TraceLine::new(ev, world.table());
+        serde_json::to_writer(&mut self.out, &line)
+            .map_err(|e| RunError::Output(e.to_string()))?;
+        self.out
+            .write_all(b"\n")
+            .map_err(|e| RunError::Output(e.to_string()))
+    }
+}
+
+/// Keeps every event's trace line in memory (for tests and for comparing engines).
+#[derive(Default)]
+pub struct TraceRecorder {
+    /// The lines so far.
+    pub lines: Vec<TraceLine>,
+}
+
+impl Observer for TraceRecorder {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
+        self.lines.push(TraceLine::new(ev, world.table()));
+        Ok(())
+    }
+}
+
+/// One ball in the final state file.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct FinalBall {
+    /// `Ball-k`.
+    pub name: String,
+    /// Centre at the end time, or where it crossed into its pocket.
+    pub position: [f64; 2],
+    /// Velocity at the end time (zero in a pocket).
+    pub velocity: [f64; 2],
+    /// The pocket holding it (`Pocket-k`), or null.
+    pub pocket: Option<String>,
+}
+
+/// The final state file: `{"t": T, "balls": [...]}`.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct FinalState {
+    /// The end time.
+    pub t: f64,
+    /// Every ball, `Ball-1` first.
+    pub balls: Vec<FinalBall>,
+}
+
+impl FinalState {
+    /// The final state of balls fixed at time `t`.
+    pub fn new(t: f64, balls: &[BallState]) -> FinalState {
+        FinalState {
+            t,
+            balls: balls
+                .iter()
+                .enumerate()
+                .map(|(i, b)| FinalBall {
+                    name: format!("Ball-{}", i + 1),
+                    position: b.position(t).into(),
+                    velocity: b.velocity().into(),
+                    pocket: b.pocket.map(|k| format!("Pocket-{}", k + 1)),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// A 64-bit FNV-1a hash, in hex, of every ball's final position and velocity bits (and pocket):
+/// equal digests mean bit-identical final states.
+pub fn digest(t: f64, balls: &[BallState]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |x: u64| {
+        for byte in x.to_le_bytes() {
+            h ^= u64::from(byte);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for b in balls {
+        let p = b.position(t);
+        let v = b.velocity();
+        for x in [p.x, p.y, v.x, v.y] {
+            eat(x.to_bits());
+        }
+        eat(b.pocket.map_or(u64::MAX, u64::from));
+    }
+    format!("{h:016x}")
+}
+
+/// Event counts by trace kind, as the summary's `events` object.
+pub fn events_json(counts: &crate::engine::EventCounts) -> serde_json::Value {
+    let mut m = serde_json::Map::new();
+    for k in EventKind::ALL {
+        m.insert(k.name().to_string(), counts.get(k).into());
+    }
+    m.insert("total".into(), counts.total().into());
+    serde_json::Value::Object(m)
+}

@@ -1,0 +1,538 @@
+//! Built-in scenarios: the thesis' set pieces and a few classic tests of simultaneous contact.
+//!
+//! | name | what it is |
+//! |---|---|
+//! | `plate1` | thesis plate 1 (4.2): Ball-2 knocks Ball-1 into the pocket in the top side |
+//! | `gas` | the thesis' hard-disk gas (ch. 6): k × k balls with random velocities on a square table |
+//! | `reversal` | the reversal test of thesis 4.6–4.7: a 4 × 4 array with random velocities |
+//! | `pool` | a racked break on a 2:1 table with six pockets |
+//! | `cradle` | Newton's cradle: one ball strikes a row of five touching balls |
+//!
+//! Coordinates have y up. Cushions and pockets run clockwise around the table, so the table lies
+//! on the right going from `from` to `to` (the right-hand normal of each side points inward).
+//!
+//! Random draws use [`ChaCha8Rng`] seeded with [`SeedableRng::seed_from_u64`] (default seed 1),
+//! whose output is specified bit for bit, and turn its numbers into positions and velocities with
+//! IEEE-754 arithmetic only (`+ - * /` and `sqrt`, which are correctly rounded; no `sin`/`cos`,
+//! whose last bit depends on the platform's maths library). A seed therefore gives the same
+//! scenario, bit for bit, on every platform.
+
+use super::{BallSpec, CushionSpec, Invalid, PocketSpec, Scenario};
+use crate::geometry::Vec2;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::f64::consts::PI;
+
+/// Parameters a generated scenario may take from the command line; `None` = the scenario's
+/// default. A scenario that has no use for a parameter rejects it, naming its flag.
+#[derive(Clone, Debug, Default)]
+pub struct Params {
+    /// `--balls N`: how many balls (gas: a square number).
+    pub balls: Option<usize>,
+    /// `--seed S`: the seed of the random velocities (default 1).
+    pub seed: Option<u64>,
+    /// `--area-fraction PHI`: the fraction of the table the balls cover, in (0, 1); sets the
+    /// table's size.
+    pub area_fraction: Option<f64>,
+    /// `--radius R`: the ball radius (length).
+    pub radius: Option<f64>,
+    /// `--speed-max V`: speeds are drawn uniform in `[0, V)` (length per time).
+    pub speed_max: Option<f64>,
+}
+
+/// The most balls a generator will lay out (about 5 GB of ball specs); more is refused with an
+/// error rather than an allocation failure.
+pub const MAX_BALLS: usize = 100_000_000;
+
+const BALLS: &str = "--balls";
+const SEED: &str = "--seed";
+const AREA: &str = "--area-fraction";
+const RADIUS: &str = "--radius";
+const SPEED: &str = "--speed-max";
+
+const DEFAULT_SEED: u64 = 1;
+
+const GAS_BALLS: usize = 36;
+const GAS_RADIUS: f64 = 30.0;
+const GAS_SPEED: f64 = 100.0;
+const GAS_SPACING: f64 = 100.0;
+const GAS_UNTIL: f64 = 4.0;
+
+const REVERSAL_SIDE: f64 = 400.0;
+const REVERSAL_RADIUS: f64 = 30.0;
+const REVERSAL_SPEED: f64 = 100.0;
+const REVERSAL_UNTIL: f64 = 3.0;
+
+/// Centres closer than `2r · (1 + GAP)` count as too close for a generated layout.
+const GAP: f64 = 1e-9;
+
+/// One built-in: its name, its description and its generator.
+struct Builtin {
+    name: &'static str,
+    describe: fn() -> String,
+    build: fn(&Params) -> Result<Scenario, Invalid>,
+}
+
+const BUILTINS: [Builtin; 5] = [
+    Builtin {
+        name: "plate1",
+        describe: || {
+            "thesis plate 1: Ball-2 strikes Ball-1 (t = 1.6), which drops into the pocket in the \
+             top side (t = 2.6); 600 x 400 table, until 3; no parameters"
+                .into()
+        },
+        build: plate1,
+    },
+    Builtin {
+        name: "gas",
+        describe: || {
+            format!(
+                "thesis ch. 6 hard-disk gas: k x k balls with random velocities on a square table \
+                 ({BALLS} {GAS_BALLS}, {RADIUS} {GAS_RADIUS}, {SPEED} {GAS_SPEED}, {SEED} \
+                 {DEFAULT_SEED}; side {GAS_SPACING} k, or set by {AREA}); until {GAS_UNTIL}"
+            )
+        },
+        build: gas,
+    },
+    Builtin {
+        name: "reversal",
+        describe: || {
+            format!(
+                "thesis 4.6-4.7 reversal test: 4 x 4 balls of radius {REVERSAL_RADIUS} with random \
+                 velocities on a {REVERSAL_SIDE} x {REVERSAL_SIDE} table ({SEED} {DEFAULT_SEED}, \
+                 {SPEED} {REVERSAL_SPEED}); until {REVERSAL_UNTIL}"
+            )
+        },
+        build: reversal,
+    },
+    Builtin {
+        name: "pool",
+        describe: || {
+            "a racked break: the cue ball at 400 into 15 touching balls on a 100 x 50 table with \
+             six pockets; until 5; no parameters"
+                .into()
+        },
+        build: pool,
+    },
+    Builtin {
+        name: "cradle",
+        describe: || {
+            "Newton's cradle: Ball-6 strikes a row of five touching balls (1000 x 200 table); \
+             until 4; no parameters"
+                .into()
+        },
+        build: cradle,
+    },
+];
+
+/// Name and one-line description (with its defaults) of every built-in, in listing order.
+pub fn list() -> Vec<(&'static str, String)> {
+    BUILTINS.iter().map(|b| (b.name, (b.describe)())).collect()
+}
+
+/// Builds and validates a built-in by name.
+///
+/// Errors: field `scenario` for an unknown name (the message lists the known ones); the flag
+/// (`--balls`, `--area-fraction`, ...) for a parameter the scenario does not take or a value it
+/// cannot use. Messages do not repeat the field, so `field: message` reads as one sentence.
+pub fn build(name: &str, p: &Params) -> Result<Scenario, Invalid> {
+    match BUILTINS.iter().find(|b| b.name == name) {
+        Some(b) => {
+            let scenario = (b.build)(p)?;
+            scenario.validate()?;
+            Ok(scenario)
+        }
+        None => {
+            let names: Vec<&str> = BUILTINS.iter().map(|b| b.name).collect();
+            Err(bad(
+                "scenario",
+                format!(
+                    "unknown built-in scenario `{name}` (known: {})",
+                    names.join(", ")
+                ),
+            ))
+        }
+    }
+}
+
+fn bad(field: &str, message: String) -> Invalid {
+    Invalid {
+        field: field.into(),
+        message,
+    }
+}
+
+/// Rejects every parameter given that `name` does not take.
+fn allow(p: &Params, name: &str, takes: &[&str]) -> Result<(), Invalid> {
+    let given = [
+        (BALLS, p.balls.is_some()),
+        (SEED, p.seed.is_some()),
+        (AREA, p.area_fraction.is_some()),
+        (RADIUS, p.radius.is_some()),
+        (SPEED, p.speed_max.is_some()),
+    ];
+    for (flag, set) in given {
+        if set && !takes.contains(&flag) {
+            let accepted = if takes.is_empty() {
+                "no parameters".to_string()
+            } else {
+                takes.join(", ")
+            };
+            return Err(bad(
+                flag,
+                format!("does not apply to scenario {name} (it takes {accepted})"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn radius_param(p: &Params, default: f64) -> Result<f64, Invalid> {
+    let r = p.radius.unwrap_or(default);
+    if r.is_finite() && r > 0.0 {
+        Ok(r)
+    } else {
+        Err(bad(RADIUS, format!("must be a positive number, got {r}")))
+    }
+}
+
+fn speed_param(p: &Params, default: f64) -> Result<f64, Invalid> {
+    let v = p.speed_max.unwrap_or(default);
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(bad(SPEED, format!("must be a finite number >= 0, got {v}")))
+    }
+}
+
+/// A velocity with speed uniform in `[0, vmax)` and direction uniform on the circle.
+///
+/// The direction is a point drawn uniformly in the unit disk (by rejection from the square),
+/// scaled to length 1: only correctly rounded operations, so every platform gets the same bits.
+fn random_velocity(rng: &mut ChaCha8Rng, vmax: f64) -> Vec2 {
+    let speed = vmax * rng.gen::<f64>();
+    loop {
+        let x = 2.0 * rng.gen::<f64>() - 1.0;
+        let y = 2.0 * rng.gen::<f64>() - 1.0;
+        let q = x * x + y * y;
+        if q > 1e-12 && q <= 1.0 {
+            let s = speed / q.sqrt();
+            return Vec2::new(s * x, s * y);
+        }
+    }
+}
+
+/// Four cushions of elasticity 1 around the rectangle `[0, w] × [0, h]`, clockwise from the
+/// left side.
+fn box_cushions(w: f64, h: f64) -> Vec<CushionSpec> {
+    let corners = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(0.0, h),
+        Vec2::new(w, h),
+        Vec2::new(w, 0.0),
+    ];
+    (0..4)
+        .map(|i| cushion(corners[i], corners[(i + 1) % 4]))
+        .collect()
+}
+
+fn cushion(from: Vec2, to: Vec2) -> CushionSpec {
+    CushionSpec {
+        from,
+        to,
+        elasticity: 1.0,
+    }
+}
+
+fn pocket(from: Vec2, to: Vec2) -> PocketSpec {
+    PocketSpec {
+        from,
+        to,
+        corner_elasticity: 1.0,
+    }
+}
+
+fn ball(x: f64, y: f64, vx: f64, vy: f64, radius: f64) -> BallSpec {
+    BallSpec {
+        position: Vec2::new(x, y),
+        velocity: Vec2::new(vx, vy),
+        radius,
+        mass: 1.0,
+    }
+}
+
+/// Thesis plate 1 (section 4.2): five cushions and one pocket in the middle of the top side of a
+/// 600 × 400 table. Ball-2 moves up at speed 100, strikes the resting Ball-1 at t = 1.6, and
+/// Ball-1's centre crosses the pocket line at t = 2.6.
+fn plate1(p: &Params) -> Result<Scenario, Invalid> {
+    allow(p, "plate1", &[])?;
+    let v = Vec2::new;
+    Ok(Scenario {
+        name: "plate1".into(),
+        until: 3.0,
+        balls: vec![
+            ball(300.0, 300.0, 0.0, 0.0, 20.0),
+            ball(300.0, 100.0, 0.0, 100.0, 20.0),
+        ],
+        cushions: vec![
+            cushion(v(0.0, 0.0), v(0.0, 400.0)),
+            cushion(v(0.0, 400.0), v(270.0, 400.0)),
+            cushion(v(330.0, 400.0), v(600.0, 400.0)),
+            cushion(v(600.0, 400.0), v(600.0, 0.0)),
+            cushion(v(600.0, 0.0), v(0.0, 0.0)),
+        ],
+        pockets: vec![pocket(v(270.0, 400.0), v(330.0, 400.0))],
+        sectors: None,
+    })
+}
+
+/// The integer `k` with `k * k == n`, if there is one.
+fn exact_sqrt(n: usize) -> Option<usize> {
+    let mut k = (n as f64).sqrt() as usize;
+    while k.checked_mul(k).map_or(true, |kk| kk > n) {
+        k -= 1;
+    }
+    while (k + 1).checked_mul(k + 1).is_some_and(|kk| kk <= n) {
+        k += 1;
+    }
+    (k * k == n).then_some(k)
+}
+
+/// The best triangular lattice for `n` balls in a square: `(m, need)`, where `m` balls fill a
+/// row and the spacing is `side / need`. Rows are offset by half a spacing and `d·√3/2` apart,
+/// and the walls stand half a spacing beyond the outermost centres, so a spacing `d > 2r` keeps
+/// every ball clear of its neighbours and of the walls.
+fn triangular_rows(n: usize) -> (usize, f64) {
+    let pitch = 3f64.sqrt() / 2.0;
+    let k = (n as f64).sqrt().ceil() as usize;
+    let mut best = (1, f64::INFINITY);
+    for m in 1..=n.min(4 * k + 4) {
+        let rows = n.div_ceil(m);
+        let need = (m as f64 + 0.5).max((rows - 1) as f64 * pitch + 1.0);
+        if need < best.1 {
+            best = (m, need);
+        }
+    }
+    best
+}
+
+/// Centres of `n = k²` balls of radius `r` in the square `[0, side]²`, row by row from the
+/// bottom left: a square grid when its spacing `side / k` is at least `2r·(1 + 1e-9)`, else the
+/// densest triangular lattice of [`triangular_rows`]. `Err` holds the largest area fraction at
+/// which one of the two fits.
+fn lattice(n: usize, k: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
+    let min_spacing = 2.0 * r * (1.0 + GAP);
+    let s = side / k as f64;
+    if s >= min_spacing {
+        let mut pts = Vec::with_capacity(n);
+        for j in 0..k {
+            for i in 0..k {
+                pts.push(Vec2::new((i as f64 + 0.5) * s, (j as f64 + 0.5) * s));
+            }
+        }
+        return Ok(pts);
+    }
+    let (m, need) = triangular_rows(n);
+    let d = side / need;
+    if d < min_spacing {
+        let smallest_side = min_spacing * need.min(k as f64);
+        return Err(n as f64 * PI * r * r / (smallest_side * smallest_side));
+    }
+    let h = d * 3f64.sqrt() / 2.0;
+    let rows = n.div_ceil(m);
+    let ox = (side - (m as f64 + 0.5) * d) / 2.0 + d / 2.0;
+    let oy = (side - ((rows - 1) as f64 * h + d)) / 2.0 + d / 2.0;
+    let mut pts = Vec::with_capacity(n);
+    'rows: for j in 0..rows {
+        let shift = if j % 2 == 1 { d / 2.0 } else { 0.0 };
+        for i in 0..m {
+            if pts.len() == n {
+                break 'rows;
+            }
+            pts.push(Vec2::new(ox + shift + i as f64 * d, oy + j as f64 * h));
+        }
+    }
+    Ok(pts)
+}
+
+/// The thesis' gas (chapter 6): `k × k` equal balls with random velocities on a square table of
+/// four perfectly elastic cushions, no pockets.
+///
+/// The side is `100 k` (the thesis' 600 × 600 for 36 balls) or, with `--area-fraction PHI`,
+/// `sqrt(N π r² / PHI)`. Velocities are drawn ball by ball in ball order.
+fn gas(p: &Params) -> Result<Scenario, Invalid> {
+    allow(p, "gas", &[BALLS, SEED, AREA, RADIUS, SPEED])?;
+    let n = p.balls.unwrap_or(GAS_BALLS);
+    if n == 0 || n > MAX_BALLS {
+        return Err(bad(
+            BALLS,
+            format!("must be a square number from 1 to {MAX_BALLS}, got {n}"),
+        ));
+    }
+    let k = exact_sqrt(n).ok_or_else(|| {
+        bad(
+            BALLS,
+            format!("must be a square number (the gas is k x k balls), got {n}"),
+        )
+    })?;
+    let r = radius_param(p, GAS_RADIUS)?;
+    let vmax = speed_param(p, GAS_SPEED)?;
+    let side = match p.area_fraction {
+        None => GAS_SPACING * k as f64,
+        Some(phi) => {
+            if !(phi.is_finite() && phi > 0.0 && phi < 1.0) {
+                return Err(bad(
+                    AREA,
+                    format!("must lie strictly between 0 and 1, got {phi}"),
+                ));
+            }
+            (n as f64 * PI * r * r / phi).sqrt()
+        }
+    };
+    if !(side.is_finite() && side > 0.0) {
+        let flag = if p.area_fraction.is_some() {
+            AREA
+        } else {
+            RADIUS
+        };
+        return Err(bad(
+            flag,
+            format!("gives a table of side {side}, which is not a usable length"),
+        ));
+    }
+    let positions = lattice(n, k, r, side).map_err(|phi_max| {
+        // Round down, so that the value printed is one that works.
+        let phi_max = (phi_max * 1e6).floor() / 1e6;
+        match p.area_fraction {
+            Some(phi) => bad(
+                AREA,
+                format!(
+                    "{phi} is too dense: {n} balls of radius {r} do not fit; the largest area \
+                     fraction that fits is {phi_max}"
+                ),
+            ),
+            None => bad(
+                RADIUS,
+                format!(
+                    "{r} is too large for {n} balls on the default {side} x {side} table; use a \
+                     smaller radius or {AREA} at most {phi_max}"
+                ),
+            ),
+        }
+    })?;
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed.unwrap_or(DEFAULT_SEED));
+    let balls = positions
+        .into_iter()
+        .map(|position| BallSpec {
+            position,
+            velocity: random_velocity(&mut rng, vmax),
+            radius: r,
+            mass: 1.0,
+        })
+        .collect();
+    Ok(Scenario {
+        name: "gas".into(),
+        until: GAS_UNTIL,
+        balls,
+        cushions: box_cushions(side, side),
+        pockets: Vec::new(),
+        sectors: None,
+    })
+}
+
+/// The reversal test of thesis 4.6–4.7: a 4 × 4 array of balls (centres 50, 150, 250, 350 on a
+/// 400 × 400 table) with random velocities, row by row from the bottom left.
+fn reversal(p: &Params) -> Result<Scenario, Invalid> {
+    allow(p, "reversal", &[SEED, SPEED])?;
+    let vmax = speed_param(p, REVERSAL_SPEED)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed.unwrap_or(DEFAULT_SEED));
+    let mut balls = Vec::with_capacity(16);
+    for j in 0..4 {
+        for i in 0..4 {
+            balls.push(BallSpec {
+                position: Vec2::new(50.0 + 100.0 * i as f64, 50.0 + 100.0 * j as f64),
+                velocity: random_velocity(&mut rng, vmax),
+                radius: REVERSAL_RADIUS,
+                mass: 1.0,
+            });
+        }
+    }
+    Ok(Scenario {
+        name: "reversal".into(),
+        until: REVERSAL_UNTIL,
+        balls,
+        cushions: box_cushions(REVERSAL_SIDE, REVERSAL_SIDE),
+        pockets: Vec::new(),
+        sectors: None,
+    })
+}
+
+/// A racked break on a 100 × 50 table (inches, 2:1 like a regulation table).
+///
+/// Six pockets are lines across their mouths: at each table corner a diagonal whose ends lie
+/// 3.25 from the corner along the two sides, and in the middle of each long side a 5-wide gap.
+/// The six cushions fill the sides between them, so a pocket's corners stand at its jaws. Sides
+/// and pockets run clockwise from the left cushion. Ball-1, the cue ball, leaves (25, 25) at
+/// speed 400 along +x into a touching triangle of Ball-2..Ball-16 whose apex is at (75, 25).
+fn pool(p: &Params) -> Result<Scenario, Invalid> {
+    allow(p, "pool", &[])?;
+    const W: f64 = 100.0;
+    const H: f64 = 50.0;
+    const R: f64 = 1.125;
+    const C: f64 = 3.25;
+    const S: f64 = 2.5;
+    let v = Vec2::new;
+    let mid = W / 2.0;
+    let cushions = vec![
+        cushion(v(0.0, C), v(0.0, H - C)),
+        cushion(v(C, H), v(mid - S, H)),
+        cushion(v(mid + S, H), v(W - C, H)),
+        cushion(v(W, H - C), v(W, C)),
+        cushion(v(W - C, 0.0), v(mid + S, 0.0)),
+        cushion(v(mid - S, 0.0), v(C, 0.0)),
+    ];
+    let pockets = vec![
+        pocket(v(0.0, H - C), v(C, H)),
+        pocket(v(mid - S, H), v(mid + S, H)),
+        pocket(v(W - C, H), v(W, H - C)),
+        pocket(v(W, C), v(W - C, 0.0)),
+        pocket(v(mid + S, 0.0), v(mid - S, 0.0)),
+        pocket(v(C, 0.0), v(0.0, C)),
+    ];
+    let mut balls = vec![ball(25.0, 25.0, 400.0, 0.0, R)];
+    let row_step = R * 3f64.sqrt();
+    for i in 0..5 {
+        for j in 0..=i {
+            let x = 75.0 + i as f64 * row_step;
+            let y = 25.0 + (j as f64 - i as f64 / 2.0) * 2.0 * R;
+            balls.push(ball(x, y, 0.0, 0.0, R));
+        }
+    }
+    Ok(Scenario {
+        name: "pool".into(),
+        until: 5.0,
+        balls,
+        cushions,
+        pockets,
+        sectors: None,
+    })
+}
+
+/// Newton's cradle on a 1000 × 200 table: Ball-1..Ball-5 (radius 10) touch in a row at y = 100,
+/// x = 500..580, at rest; Ball-6 leaves (300, 100) at speed 100 along +x and strikes Ball-1 at
+/// t = 1.8.
+fn cradle(p: &Params) -> Result<Scenario, Invalid> {
+    allow(p, "cradle", &[])?;
+    let mut balls: Vec<BallSpec> = (0..5)
+        .map(|i| ball(500.0 + 20.0 * i as f64, 100.0, 0.0, 0.0, 10.0))
+        .collect();
+    balls.push(ball(300.0, 100.0, 100.0, 0.0, 10.0));
+    Ok(Scenario {
+        name: "cradle".into(),
+        until: 4.0,
+        balls,
+        cushions: box_cushions(1000.0, 200.0),
+        pockets: Vec::new(),
+        sectors: None,
+    })
+}

@@ -1,0 +1,401 @@
+//! Scenarios: the table (cushions, pockets and their corners) and the balls at time 0.
+//!
+//! A scenario comes from a TOML file (`toml` submodule, the format of DESIGN.md) or from a
+//! built-in generator (`builtin`). Either way it is validated once, by [`Scenario::validate`],
+//! before any engine sees it; engines may then assume every number is finite, radii and masses are
+//! positive, elasticities lie in `[0, 1]`, no segment has zero length and no two balls overlap.
+
+pub mod builtin;
+pub mod toml;
+
+use crate::geometry::Vec2;
+use std::fmt;
+
+/// A ball at time 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BallSpec {
+    /// Centre at time 0 (length).
+    pub position: Vec2,
+    /// Velocity at time 0 (length per time).
+    pub velocity: Vec2,
+    /// Radius (length), positive.
+    pub radius: f64,
+    /// Mass (any consistent unit), positive.
+    pub mass: f64,
+}
+
+/// A straight cushion. Going from `from` to `to`, the table lies on the right (thesis 3.1.2 and
+/// DESIGN.md: cushions run clockwise around the table).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CushionSpec {
+    /// First end (length).
+    pub from: Vec2,
+    /// Second end (length).
+    pub to: Vec2,
+    /// Ratio of speed after to speed before a bounce, in `[0, 1]` (thesis 3.2).
+    pub elasticity: f64,
+}
+
+/// A pocket: a line that a ball's centre crosses to drop in (thesis 3.1.3), with a corner at each
+/// end (thesis 3.1.4). Oriented like a cushion: the table lies on the right going `from` → `to`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PocketSpec {
+    /// First end (length); the first corner of the pocket stands here.
+    pub from: Vec2,
+    /// Second end (length); the second corner of the pocket stands here.
+    pub to: Vec2,
+    /// Elasticity of the pocket's two corners, in `[0, 1]` (thesis 3.3).
+    pub corner_elasticity: f64,
+}
+
+/// How the table is divided into sectors (chapter 5). Kept from the scenario for the sectored
+/// engines; the event-list engine ignores it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SectorSpec {
+    /// A grid of `nx` × `ny` equal rectangles over the table's bounding box.
+    Grid {
+        /// Sectors along x.
+        nx: u32,
+        /// Sectors along y.
+        ny: u32,
+    },
+    /// Explicit polygons, each a list of vertices (length).
+    Polygons(Vec<Vec<Vec2>>),
+}
+
+/// A whole scenario: the table, the balls at time 0 and the default end time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// Name shown in summaries: the built-in's name or the file path.
+    pub name: String,
+    /// Default end time of a run.
+    pub until: f64,
+    /// Balls, `Ball-1` first.
+    pub balls: Vec<BallSpec>,
+    /// Cushions, `Cushion-1` first.
+    pub cushions: Vec<CushionSpec>,
+    /// Pockets, `Pocket-1` first; pocket `k` (from 0) owns corners `2k` and `2k + 1`.
+    pub pockets: Vec<PocketSpec>,
+    /// Optional sector layout.
+    pub sectors: Option<SectorSpec>,
+}
+
+/// What is wrong with a scenario: one line naming the place and the field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScenarioError {
+    /// The file (or built-in name) the scenario came from.
+    pub source: String,
+    /// The 1-based line in the file, where there is one.
+    pub line: Option<usize>,
+    /// The offending field, such as `ball[3].radius` (1-based like the object names).
+    pub field: String,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+impl fmt::Display for ScenarioError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(line) => write!(f, "{}:{}: ", self.source, line)?,
+            None => write!(f, "{}: ", self.source)?,
+        }
+        if self.field.is_empty() {
+            write!(f, "{}", self.message)
+        } else {
+            write!(f, "{}: {}", self.field, self.message)
+        }
+    }
+}
+
+impl std::error::Error for ScenarioError {}
+
+/// A field that failed validation: its path and the complaint (the caller adds file and line).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Invalid {
+    /// Path of the field, such as `ball[2].position` (1-based indices).
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+fn invalid(field: String, message: String) -> Invalid {
+    Invalid { field, message }
+}
+
+fn check_finite(field: &str, v: f64) -> Result<(), Invalid> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(field.into(), format!("must be a finite number, got {v}")))
+    }
+}
+
+fn check_vec(field: &str, v: Vec2) -> Result<(), Invalid> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(
+            field.into(),
+            format!("must be two finite numbers, got [{}, {}]", v.x, v.y),
+        ))
+    }
+}
+
+fn check_positive(field: &str, v: f64) -> Result<(), Invalid> {
+    check_finite(field, v)?;
+    if v > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(field.into(), format!("must be positive, got {v}")))
+    }
+}
+
+fn check_elasticity(field: &str, v: f64) -> Result<(), Invalid> {
+    check_finite(field, v)?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(())
+    } else {
+        Err(invalid(field.into(), format!("must lie in [0, 1], got {v}")))
+    }
+}
+
+fn check_segment(field: &str, from: Vec2, to: Vec2) -> Result<(), Invalid> {
+    check_vec(&format!("{field}.from"), from)?;
+    check_vec(&format!("{field}.to"), to)?;
+    if from == to {
+        Err(invalid(
+            field.into(),
+            format!("has zero length (from = to = [{}, {}])", from.x, from.y),
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+impl Scenario {
+    /// The number of corners: two per pocket.
+    pub fn corner_count(&self) -> usize {
+        2 * self.pockets.len()
+    }
+
+    /// The position of corner `k` (0-based): pocket `k / 2`'s `from` end for even `k`, `to` for odd.
+    pub fn corner_position(&self, k: usize) -> Vec2 {
+        let p = &self.pockets[k / 2];
+        if k % 2 == 0 {
+            p.from
+        } else {
+            p.to
+        }
+    }
+
+    /// The lower-left and upper-right corners of the box around every cushion and pocket end,
+    /// or around the balls when the table has no sides.
+    pub fn bounds(&self) -> (Vec2, Vec2) {
+        let mut pts: Vec<Vec2> = self
+            .cushions
+            .iter()
+            .flat_map(|c| [c.from, c.to])
+            .chain(self.pockets.iter().flat_map(|p| [p.from, p.to]))
+            .collect();
+        if pts.is_empty() {
+            pts = self
+                .balls
+                .iter()
+                .flat_map(|b| {
+                    let r = Vec2::new(b.radius, b.radius);
+                    [b.position - r, b.position + r]
+                })
+                .collect();
+        }
+        let mut lo = Vec2::new(f64::INFINITY, f64::INFINITY);
+        let mut hi = Vec2::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for p in pts {
+            lo = Vec2::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Vec2::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+        if pts_empty(lo) {
+            (Vec2::ZERO, Vec2::new(1.0, 1.0))
+        } else {
+            (lo, hi)
+        }
+    }
+
+    /// Checks every rule engines rely on; the first broken one is returned with its field path.
+    /// Overlap is found with a sort along x, so validation of a million balls stays fast.
+    pub fn validate(&self) -> Result<(), Invalid> {
+        check_finite("run.until", self.until)?;
+        if self.until < 0.0 {
+            return Err(invalid(
+                "run.until".into(),
+                format!("must not be negative, got {}", self.until),
+            ));
+        }
+        for (i, b) in self.balls.iter().enumerate() {
+            let f = format!("ball[{}]", i + 1);
+            check_vec(&format!("{f}.position"), b.position)?;
+            check_vec(&format!("{f}.velocity"), b.velocity)?;
+            check_positive(&format!("{f}.radius"), b.radius)?;
+            check_positive(&format!("{f}.mass"), b.mass)?;
+        }
+        for (i, c) in self.cushions.iter().enumerate() {
+            let f = format!("cushion[{}]", i + 1);
+            check_segment(&f, c.from, c.to)?;
+            check_elasticity(&format!("{f}.elasticity"), c.elasticity)?;
+        }
+        for (i, p) in self.pockets.iter().enumerate() {
+            let f = format!("pocket[{}]", i + 1);
+            check_segment(&f, p.from, p.to)?;
+            check_elasticity(&format!("{f}.corner_elasticity"), p.corner_elasticity)?;
+        }
+        self.check_overlaps()?;
+        self.check_on_table()?;
+        self.check_sectors()
+    }
+
+    fn check_overlaps(&self) -> Result<(), Invalid> {
+        let rmax = self.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+        let mut order: Vec<usize> = (0..self.balls.len()).collect();
+        order.sort_by(|&a, &b| self.balls[a].position.x.total_cmp(&self.balls[b].position.x));
+        for (k, &i) in order.iter().enumerate() {
+            let bi = &self.balls[i];
+            for &j in &order[k + 1..] {
+                let bj = &self.balls[j];
+                if bj.position.x - bi.position.x > bi.radius + rmax {
+                    break;
+                }
+                let sigma = bi.radius + bj.radius;
+                let d2 = (bj.position - bi.position).norm2();
+                // Touching is allowed (a rack, a cradle); overlap beyond rounding is not.
+                if d2 < sigma * sigma * (1.0 - 1e-12) {
+                    let (lo, hi) = (i.min(j), i.max(j));
+                    return Err(invalid(
+                        format!("ball[{}].position", hi + 1),
+                        format!(
+                            "Ball-{} overlaps Ball-{} at t = 0 (centres {:.6} apart, radii sum {})",
+                            hi + 1,
+                            lo + 1,
+                            d2.sqrt(),
+                            sigma
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn check_on_table(&self) -> Result<(), Invalid> {
+        if self.cushions.is_empty() && self.pockets.is_empty() {
+            return Ok(());
+        }
+        let (lo, hi) = self.bounds();
+        for (i, b) in self.balls.iter().enumerate() {
+            let p = b.position;
+            let inside_box = p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y;
+            let through_cushion = self.cushions.iter().position(|c| {
+                let l = c.to - c.from;
+                let len = l.norm();
+                let along = (p - c.from).dot(l) / len;
+                let into = (p - c.from).dot(l.perp_cw()) / len;
+                along >= 0.0 && along <= len && into.abs() < b.radius * (1.0 - 1e-9)
+            });
+            if !inside_box {
+                return Err(invalid(
+                    format!("ball[{}].position", i + 1),
+                    format!(
+                        "Ball-{} at [{}, {}] is off the table (table spans [{}, {}] to [{}, {}])",
+                        i + 1,
+                        p.x,
+                        p.y,
+                        lo.x,
+                        lo.y,
+                        hi.x,
+                        hi.y
+                    ),
+                ));
+            }
+            if let Some(c) = through_cushion {
+                return Err(invalid(
+                    format!("ball[{}].position", i + 1),
+                    format!("Ball-{} overlaps Cushion-{} at t = 0", i + 1, c + 1),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn check_sectors(&self) -> Result<(), Invalid> {
+        match &self.sectors {
+            None => Ok(()),
+            Some(SectorSpec::Grid { nx, ny }) => {
+                if *nx == 0 || *ny == 0 {
+                    Err(invalid(
+                        "sectors.grid".into(),
+                        format!("needs at least one sector per side, got [{nx}, {ny}]"),
+                    ))
+                } else {
+                    Ok(())
+                }
+            }
+            Some(SectorSpec::Polygons(polys)) => {
+                for (i, poly) in polys.iter().enumerate() {
+                    let f = format!("sectors.polygon[{}].points", i + 1);
+                    if poly.len() < 3 {
+                        return Err(invalid(f, "a polygon needs at least 3 points".into()));
+                    }
+                    for p in poly {
+                        check_vec(&f, *p)?;
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+fn pts_empty(lo: Vec2) -> bool {
+    !lo.x.is_finite()
+}
+
+/// Loads a scenario by built-in name or TOML path. Generator parameters (`params`) are only
+/// accepted by built-ins that use them; a file takes none.
+pub fn load(spec: &str, params: &builtin::Params) -> Result<Scenario, ScenarioError> {
+    let is_builtin = builtin::list().iter().any(|(name, _)| *name == spec);
+    if is_builtin {
+        return builtin::build(spec, params).map_err(|e| ScenarioError {
+            source: format!("built-in scenario {spec}"),
+            line: None,
+            field: e.field,
+            message: e.message,
+        });
+    }
+    let path = std::path::Path::new(spec);
+    if !path.exists() {
+        let names: Vec<&str> = builtin::list().iter().map(|(n, _)| *n).collect();
+        return Err(ScenarioError {
+            source: spec.to_string(),
+            line: None,
+            field: String::new(),
+            message: format!(
+                "no such file, and not a built-in scenario (built-ins: {})",
+                names.join(", ")
+            ),
+        });
+    }
+    let given = [
+        ("--balls", params.balls.is_some()),
+        ("--seed", params.seed.is_some()),
+        ("--area-fraction", params.area_fraction.is_some()),
+        ("--radius", params.radius.is_some()),
+        ("--speed-max", params.speed_max.is_some()),
+    ];
+    if let Some((flag, _)) = given.iter().find(|(_, set)| *set) {
+        return Err(ScenarioError {
+            source: spec.to_string(),
+            line: None,
+            field: (*flag).to_string(),
+            message: "only generated (built-in) scenarios take this option".into(),
+        });
+    }
+    toml::load(path)
+}
