@@ -150,9 +150,9 @@ fn fig12_ball_resting_on_a_cushion_struck() {
     assert_eq!(
         events(&trace),
         vec![
-            (8.0, "ball-ball", "Ball-1", "Ball-2"),
-            (8.0, "ball-cushion", "Ball-1", "Cushion-3"),
-            (8.0, "ball-ball", "Ball-1", "Ball-2"),
+            (7.0, "ball-ball", "Ball-1", "Ball-2"),
+            (7.0, "ball-cushion", "Ball-1", "Cushion-3"),
+            (7.0, "ball-ball", "Ball-1", "Ball-2"),
         ]
     );
     assert_eq!(balls[0].traj.velocity, v(0.0, 0.0));

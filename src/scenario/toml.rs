@@ -611,3 +611,281 @@ fn header_line(text: &str, name: &str) -> Option<usize> {
         _ => None,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A valid file; the tests below replace one numbered line to break it.
+    const BASE: &str = "\
+[run]
+until = 3.0
+
+[[ball]]
+position = [100.0, 100.0]
+velocity = [10.0, 0.0]
+radius = 20.0
+
+[[ball]]
+position = [200.0, 100.0]
+radius = 20.0
+mass = 2.0
+
+[[cushion]]
+from = [0.0, 0.0]
+to = [0.0, 400.0]
+[[cushion]]
+from = [0.0, 400.0]
+to = [400.0, 400.0]
+elasticity = 0.5
+[[cushion]]
+from = [400.0, 400.0]
+to = [400.0, 0.0]
+[[cushion]]
+from = [400.0, 0.0]
+to = [220.0, 0.0]
+[[cushion]]
+from = [180.0, 0.0]
+to = [0.0, 0.0]
+
+[[pocket]]
+from = [220.0, 0.0]
+to = [180.0, 0.0]
+elasticity = 0.8
+
+[sectors]
+grid = [2, 3]
+";
+
+    /// `BASE` with its 1-based line `n` replaced by `text`.
+    fn with_line(n: usize, text: &str) -> String {
+        let mut lines: Vec<&str> = BASE.lines().collect();
+        lines[n - 1] = text;
+        lines.join("\n") + "\n"
+    }
+
+    fn fails(text: &str) -> ScenarioError {
+        match parse(text, "t.toml") {
+            Ok(_) => panic!("expected an error for:\n{text}"),
+            Err(e) => e,
+        }
+    }
+
+    /// Asserts the error's line, field and a piece of its message, and that it is one line.
+    fn assert_error(e: &ScenarioError, line: usize, field: &str, part: &str) {
+        let shown = e.to_string();
+        assert_eq!(e.line, Some(line), "{shown}");
+        assert_eq!(e.field, field, "{shown}");
+        assert!(e.message.contains(part), "{shown} lacks {part:?}");
+        assert!(
+            shown.starts_with(&format!("t.toml:{line}: {field}: ")),
+            "{shown}"
+        );
+        assert!(!shown.contains('\n'), "{shown}");
+    }
+
+    #[test]
+    fn base_file_round_trips() {
+        let s = parse(BASE, "t.toml").unwrap();
+        assert_eq!(s.name, "t.toml");
+        assert_eq!(s.until, 3.0);
+        assert_eq!(s.balls.len(), 2);
+        assert_eq!(
+            s.balls[0],
+            BallSpec {
+                position: Vec2::new(100.0, 100.0),
+                velocity: Vec2::new(10.0, 0.0),
+                radius: 20.0,
+                mass: 1.0,
+            }
+        );
+        assert_eq!(s.balls[1].velocity, Vec2::ZERO);
+        assert_eq!(s.balls[1].mass, 2.0);
+        assert_eq!(s.cushions.len(), 5);
+        assert_eq!(s.cushions[0].elasticity, 1.0);
+        assert_eq!(s.cushions[1].elasticity, 0.5);
+        assert_eq!(s.cushions[3].to, Vec2::new(220.0, 0.0));
+        assert_eq!(
+            s.pockets,
+            vec![PocketSpec {
+                from: Vec2::new(220.0, 0.0),
+                to: Vec2::new(180.0, 0.0),
+                corner_elasticity: 0.8,
+            }]
+        );
+        assert_eq!(s.corner_count(), 2);
+        assert_eq!(s.corner_position(0), Vec2::new(220.0, 0.0));
+        assert_eq!(s.corner_position(1), Vec2::new(180.0, 0.0));
+        assert_eq!(s.sectors, Some(SectorSpec::Grid { nx: 2, ny: 3 }));
+    }
+
+    #[test]
+    fn defaults_apply() {
+        let s = parse("[[ball]]\nposition = [0, 0]\nradius = 1\n", "d.toml").unwrap();
+        assert_eq!(s.until, DEFAULT_UNTIL);
+        assert_eq!(s.balls[0].velocity, Vec2::ZERO);
+        assert_eq!(s.balls[0].mass, 1.0);
+        assert!(s.cushions.is_empty() && s.pockets.is_empty() && s.sectors.is_none());
+        let s = parse(
+            "[[pocket]]\nfrom = [0, 1]\nto = [0, 0]\n[[cushion]]\nfrom = [0, 0]\nto = [0, 1]\n",
+            "d.toml",
+        )
+        .unwrap();
+        assert_eq!(s.pockets[0].corner_elasticity, 1.0);
+        assert_eq!(s.cushions[0].elasticity, 1.0);
+        assert_eq!(parse("", "e.toml").unwrap().balls.len(), 0);
+    }
+
+    #[test]
+    fn polygon_sectors_round_trip() {
+        let text = "[[sectors.polygon]]\npoints = [[0, 0], [0, 1], [1, 1]]\n\
+                    [[sectors.polygon]]\npoints = [\n  [1, 1],\n  [1, 0], # comment\n  [0, 0],\n]\n";
+        let s = parse(text, "p.toml").unwrap();
+        let Some(SectorSpec::Polygons(polys)) = s.sectors else {
+            panic!("no polygons")
+        };
+        assert_eq!(polys.len(), 2);
+        assert_eq!(polys[1][1], Vec2::new(1.0, 0.0));
+    }
+
+    #[test]
+    fn overlapping_balls_name_both() {
+        let e = fails(&with_line(10, "position = [130.0, 100.0]"));
+        assert_error(&e, 10, "ball[2].position", "Ball-2 overlaps Ball-1");
+    }
+
+    #[test]
+    fn ball_off_the_table() {
+        let e = fails(&with_line(10, "position = [500.0, 100.0]"));
+        assert_error(&e, 10, "ball[2].position", "off the table");
+    }
+
+    #[test]
+    fn ball_through_a_cushion() {
+        let e = fails(&with_line(5, "position = [10.0, 100.0]"));
+        assert_error(&e, 5, "ball[1].position", "Ball-1 overlaps Cushion-1");
+    }
+
+    #[test]
+    fn radius_not_positive() {
+        let e = fails(&with_line(7, "radius = 0.0"));
+        assert_error(&e, 7, "ball[1].radius", "must be positive, got 0");
+    }
+
+    #[test]
+    fn mass_not_positive() {
+        let e = fails(&with_line(12, "mass = -2.0"));
+        assert_error(&e, 12, "ball[2].mass", "must be positive, got -2");
+    }
+
+    #[test]
+    fn nan_position() {
+        let e = fails(&with_line(5, "position = [nan, 100.0]"));
+        assert_error(&e, 5, "ball[1].position", "finite");
+    }
+
+    #[test]
+    fn infinite_velocity() {
+        let e = fails(&with_line(6, "velocity = [10.0, -inf]"));
+        assert_error(&e, 6, "ball[1].velocity", "finite");
+    }
+
+    #[test]
+    fn elasticity_above_one() {
+        let e = fails(&with_line(20, "elasticity = 1.5"));
+        assert_error(&e, 20, "cushion[2].elasticity", "must lie in [0, 1], got 1.5");
+    }
+
+    #[test]
+    fn pocket_elasticity_is_named_as_in_the_file() {
+        let e = fails(&with_line(34, "elasticity = -0.1"));
+        assert_error(&e, 34, "pocket[1].elasticity", "must lie in [0, 1]");
+    }
+
+    #[test]
+    fn zero_length_cushion() {
+        let e = fails(&with_line(19, "to = [0.0, 400.0]"));
+        assert_error(&e, 17, "cushion[2]", "zero length");
+    }
+
+    #[test]
+    fn unknown_key() {
+        let e = fails(&with_line(8, "colour = 3"));
+        assert_error(&e, 8, "ball[1].colour", "unknown field `colour`");
+        let e = fails(&with_line(3, "speed = 3"));
+        assert_error(&e, 3, "run.speed", "unknown field `speed`");
+        let e = fails(&with_line(35, "[table]"));
+        assert_error(&e, 35, "table", "unknown field `table`");
+    }
+
+    #[test]
+    fn missing_key() {
+        let e = fails(&with_line(7, "# no radius"));
+        assert_error(&e, 4, "ball[1]", "missing field `radius`");
+    }
+
+    #[test]
+    fn wrong_types() {
+        let e = fails(&with_line(7, "radius = \"big\""));
+        assert_error(&e, 7, "ball[1].radius", "invalid type: string \"big\", expected f64");
+        let e = fails(&with_line(10, "position = [1.0, 2.0, 3.0]"));
+        assert_error(&e, 10, "ball[2].position", "invalid length 3");
+        let e = fails(&with_line(37, "grid = [2, -3]"));
+        assert_error(&e, 37, "sectors.grid", "invalid value: integer `-3`");
+        let e = fails(&with_line(7, "radius.x = 1"));
+        assert_error(&e, 7, "ball[1].radius.x", "table, expected a single value");
+    }
+
+    #[test]
+    fn malformed_toml() {
+        let e = fails(&with_line(15, "from = [0.0, 0.0"));
+        assert_eq!(e.field, "");
+        assert_eq!(e.line, Some(16), "{e}");
+        assert_eq!(e.to_string(), "t.toml:16: invalid array; expected `]`");
+        let e = fails(&with_line(7, "radius = = 20"));
+        assert_eq!((e.line, e.field.as_str()), (Some(7), ""), "{e}");
+        assert!(!e.to_string().contains('\n'));
+        let e = fails(&with_line(11, "radius = 20.0\nradius = 21.0"));
+        assert_eq!(e.line, Some(12), "{e}");
+        assert!(e.message.contains("duplicate key `radius`"), "{e}");
+    }
+
+    #[test]
+    fn negative_until() {
+        let e = fails(&with_line(2, "until = -1.0"));
+        assert_error(&e, 2, "run.until", "must not be negative, got -1");
+        let e = fails(&with_line(2, "until = nan"));
+        assert_error(&e, 2, "run.until", "finite");
+    }
+
+    #[test]
+    fn sector_errors() {
+        let e = fails(&with_line(37, "grid = [0, 3]"));
+        assert_error(&e, 37, "sectors.grid", "at least one sector");
+        let e = fails(&format!("{BASE}[[sectors.polygon]]\npoints = [[0, 0], [1, 1]]\n"));
+        assert_error(&e, 37, "sectors", "not both");
+        let e = fails(&with_line(37, "# no grid"));
+        assert_error(&e, 36, "sectors", "needs grid");
+        let text = "[[sectors.polygon]]\npoints = [[0, 0], [0, 1], [1, 1]]\n\
+                    [[sectors.polygon]]\npoints = [\n  [0, 0],\n  [1, 1],\n]\n";
+        let e = fails(text);
+        assert_error(&e, 4, "sectors.polygon[2].points", "at least 3 points");
+    }
+
+    #[test]
+    fn deep_nesting_is_an_error_not_a_crash() {
+        let text = format!("a = {}{}\n", "[".repeat(100_000), "]".repeat(100_000));
+        assert_eq!(fails(&text).line, Some(1));
+        let text = format!("a = {}\n", "{b = ".repeat(100_000));
+        assert_eq!(fails(&text).line, Some(1));
+    }
+
+    #[test]
+    fn field_scan_skips_strings_and_multiline_values() {
+        let text = "a = \"\"\"\n[x]\n\"\"\"\nb = [\n [1],\n]\n[[ball]]\nc = '['\nd = 1\n";
+        let at = text.find("d = 1").unwrap();
+        assert_eq!(field_at(text, at), "ball[1].d");
+        assert_eq!(field_at(text, 0), "a");
+        assert_eq!(line_of(text, usize::MAX), text.lines().count() + 1);
+    }
+}
