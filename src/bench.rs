@@ -15,10 +15,18 @@ use std::time::Instant;
 #[derive(clap::Args, Clone, Debug)]
 pub struct BenchArgs {
     /// Ball counts (each rounded to a square number).
-    #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1000,10000,100000,1000000"
+    )]
     pub balls: Vec<usize>,
     /// Area fractions.
-    #[arg(long = "area-fractions", value_delimiter = ',', default_value = "0.3,0.6")]
+    #[arg(
+        long = "area-fractions",
+        value_delimiter = ',',
+        default_value = "0.3,0.6"
+    )]
     pub area_fractions: Vec<f64>,
     /// Physical events measured per configuration (at least 5 per ball are run).
     #[arg(long, default_value_t = 2_000_000)]
@@ -126,7 +134,9 @@ pub fn measure(
 pub fn run(a: &BenchArgs) -> Result<(), String> {
     for &phi in &a.area_fractions {
         if !(phi > 0.0 && phi < 1.0) {
-            return Err(format!("--area-fractions: each must lie in (0, 1), got {phi}"));
+            return Err(format!(
+                "--area-fractions: each must lie in (0, 1), got {phi}"
+            ));
         }
     }
     let m = machine();
@@ -158,7 +168,10 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         }
     }
     if a.json {
-        println!("{}", json!({"machine": m, "engine": "event-list", "rows": rows}));
+        println!(
+            "{}",
+            json!({"machine": m, "engine": "event-list", "rows": rows})
+        );
     }
     Ok(())
 }

@@ -50,8 +50,7 @@ impl Checker {
     }
 
     fn check_ball(world: &dyn World, i: u32, t: f64) -> Result<(), RunError> {
-        let balls = world.balls();
-        let bi = &balls[i as usize];
+        let bi = &world.ball(i);
         if bi.pocket.is_some() {
             return Ok(());
         }
@@ -59,7 +58,7 @@ impl Checker {
         let p = bi.traj.at(t);
         let mut err = None;
         world.for_each_neighbor(i, &mut |j| {
-            let bj = &balls[j as usize];
+            let bj = &world.ball(j);
             if err.is_some() || bj.pocket.is_some() {
                 return;
             }
@@ -111,12 +110,9 @@ impl Checker {
     pub fn sweep(&mut self, world: &dyn World, t: f64) -> Result<(), RunError> {
         self.sweeps += 1;
         self.since_sweep = 0;
-        let balls = world.balls();
-        for i in 0..balls.len() as u32 {
+        for i in 0..world.n_balls() as u32 {
             Self::check_ball(world, i, t)?;
-        }
-        for (e, b) in self.energy.iter_mut().zip(balls) {
-            *e = ball_energy(b);
+            self.energy[i as usize] = ball_energy(&world.ball(i));
         }
         self.total = self.energy.iter().sum();
         self.check_energy(t)
@@ -140,19 +136,18 @@ impl Checker {
 
 impl Observer for Checker {
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
-        let balls = world.balls();
-        let n_balls = balls.len() as u32;
+        let n_balls = world.n_balls();
         for i in [ev.a, ev.b] {
-            if i < n_balls {
+            if (i as usize) < n_balls {
                 Self::check_ball(world, i, ev.t)?;
-                let e = ball_energy(&balls[i as usize]);
+                let e = ball_energy(&world.ball(i));
                 self.total += e - self.energy[i as usize];
                 self.energy[i as usize] = e;
             }
         }
         self.check_energy(ev.t)?;
         self.since_sweep += 1;
-        if self.since_sweep >= balls.len().max(1) {
+        if self.since_sweep >= n_balls.max(1) {
             self.sweep(world, ev.t)?;
         }
         Ok(())

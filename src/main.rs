@@ -14,7 +14,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "poolsim", version, about = "Exact event-driven simulation of pool balls and hard disks (after Goldberg, UCLA 1984)")]
+#[command(
+    name = "poolsim",
+    version,
+    about = "Exact event-driven simulation of pool balls and hard disks (after Goldberg, UCLA 1984)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -98,7 +102,7 @@ enum Command {
     /// List the built-in scenarios.
     Scenarios,
     /// Run a scenario.
-    Run(RunArgs),
+    Run(Box<RunArgs>),
     /// The main job: run the thesis' 36-ball gas with checks on and print the summary.
     Demo {
         /// Print the summary as JSON.
@@ -138,7 +142,7 @@ struct Progress {
 
 impl Progress {
     fn new(until: f64, quiet: bool) -> Option<Progress> {
-        if quiet || !std::io::stderr().is_terminal() || !(until > 0.0) {
+        if quiet || !std::io::stderr().is_terminal() || until.is_nan() || until <= 0.0 {
             return None;
         }
         let bar = ProgressBar::new(1000);
@@ -157,11 +161,13 @@ impl Progress {
 impl Observer for Progress {
     fn on_event(&mut self, ev: &Event, _: &dyn World) -> Result<(), RunError> {
         self.seen += 1;
-        if self.seen % 8192 == 0 {
+        if self.seen.is_multiple_of(8192) {
             self.bar
                 .set_position((ev.t / self.until * 1000.0).clamp(0.0, 1000.0) as u64);
-            self.bar
-                .set_message(format!("t = {:.3} / {}, {} events", ev.t, self.until, self.seen));
+            self.bar.set_message(format!(
+                "t = {:.3} / {}, {} events",
+                ev.t, self.until, self.seen
+            ));
         }
         Ok(())
     }
@@ -180,9 +186,8 @@ fn engine_of(a: &RunArgs) -> Result<EngineKind, Failure> {
             Ok(EngineKind::EventList)
         }
         "time-step" => {
-            let dt = a
-                .dt
-                .ok_or_else(|| usage("--dt: the time-step engine needs a time step"))?;
+            let dt =
+                a.dt.ok_or_else(|| usage("--dt: the time-step engine needs a time step"))?;
             if !(dt.is_finite() && dt > 0.0) {
                 return Err(usage(format!("--dt: must be a positive number, got {dt}")));
             }
@@ -225,7 +230,12 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
     };
     let mut trace = match &a.trace {
         Some(p) => Some(TraceWriter::new(BufWriter::new(File::create(p).map_err(
-            |e| usage(format!("{}: cannot create the trace file: {e}", p.display())),
+            |e| {
+                usage(format!(
+                    "{}: cannot create the trace file: {e}",
+                    p.display()
+                ))
+            },
         )?))),
         None => None,
     };
@@ -248,8 +258,12 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
     if let Some(p) = &a.final_state {
         let fs = FinalState::new(report.outcome.t, &report.outcome.balls);
         let text = serde_json::to_string_pretty(&fs).expect("a final state serializes");
-        std::fs::write(p, text + "\n")
-            .map_err(|e| usage(format!("{}: cannot write the final state: {e}", p.display())))?;
+        std::fs::write(p, text + "\n").map_err(|e| {
+            usage(format!(
+                "{}: cannot write the final state: {e}",
+                p.display()
+            ))
+        })?;
     }
     print_summary(&report.summary, a.json);
     Ok(())
@@ -296,7 +310,10 @@ fn print_summary(summary: &serde_json::Value, json: bool) {
         ke["pocketed"],
         ke["relative_drift"].as_f64().unwrap_or(0.0)
     );
-    println!("digest        {}", s["final_state_digest"].as_str().unwrap_or(""));
+    println!(
+        "digest        {}",
+        s["final_state_digest"].as_str().unwrap_or("")
+    );
     println!(
         "wall          {:.3} s, {:.0} events/s{}",
         s["wall_seconds"].as_f64().unwrap_or(0.0),
@@ -333,7 +350,7 @@ fn main() -> ExitCode {
         }
         Command::Run(a) => run(a),
         Command::Demo { json } => demo(*json),
-        Command::Bench(b) => poolsim::bench::run(b).map_err(|e| usage(e)),
+        Command::Bench(b) => poolsim::bench::run(b).map_err(usage),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

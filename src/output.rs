@@ -48,8 +48,7 @@ impl<W: Write> TraceWriter<W> {
 impl<W: Write> Observer for TraceWriter<W> {
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
         let line = TraceLine::new(ev, world.table());
-        serde_json::to_writer(&mut self.out, &line)
-            .map_err(|e| RunError::Output(e.to_string()))?;
+        serde_json::to_writer(&mut self.out, &line).map_err(|e| RunError::Output(e.to_string()))?;
         self.out
             .write_all(b"\n")
             .map_err(|e| RunError::Output(e.to_string()))

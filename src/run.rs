@@ -98,11 +98,10 @@ pub fn execute(
     let start = Instant::now();
     let initial = BallState::initial(scenario);
     let table = Table::new(scenario);
-    let checker = cfg.check.then(|| Checker::new(&initial, table.is_elastic()));
-    let mut sinks = Sinks {
-        checker,
-        user: obs,
-    };
+    let checker = cfg
+        .check
+        .then(|| Checker::new(&initial, table.is_elastic()));
+    let mut sinks = Sinks { checker, user: obs };
     let outcome = match cfg.engine {
         EngineKind::EventList => {
             let mut e = EventList::new(scenario, event_list::Options::default());

@@ -53,7 +53,10 @@ fn fig06_ball_hits_the_corner_not_the_pocket() {
     let t = (100.0 - 300f64.sqrt()) / 100.0;
     assert_eq!(trace.len(), 1);
     assert_eq!(trace[0].kind, "ball-corner");
-    assert_eq!(trace[0].objects, ["Ball-1".to_string(), "Corner-1".to_string()]);
+    assert_eq!(
+        trace[0].objects,
+        ["Ball-1".to_string(), "Corner-1".to_string()]
+    );
     assert!((trace[0].t - t).abs() < 1e-12);
     assert_eq!(balls[0].pocket, None);
     assert_close(balls[0].traj.velocity, v(50.0 * 3f64.sqrt(), -50.0), 1e-9);
@@ -62,7 +65,10 @@ fn fig06_ball_hits_the_corner_not_the_pocket() {
 #[test]
 fn ball_aimed_at_a_corner_point_comes_straight_back() {
     let (trace, balls) = run(&scenario("corner_point"));
-    assert_eq!(events(&trace), vec![(9.0, "ball-corner", "Ball-1", "Corner-1")]);
+    assert_eq!(
+        events(&trace),
+        vec![(9.0, "ball-corner", "Ball-1", "Corner-1")]
+    );
     assert_eq!(balls[0].traj.velocity, v(6.0, -8.0));
 }
 
@@ -135,9 +141,15 @@ fn fig11_serial_order_matters_and_is_canonical() {
     };
     let canonical = serial(true);
     let other = serial(false);
-    assert!((canonical[1] - other[1]).norm() > 1.0, "order must matter here");
+    assert!(
+        (canonical[1] - other[1]).norm() > 1.0,
+        "order must matter here"
+    );
     assert_eq!(trace[0].t, 8.0);
-    assert_eq!(trace[0].objects, ["Ball-1".to_string(), "Ball-2".to_string()]);
+    assert_eq!(
+        trace[0].objects,
+        ["Ball-1".to_string(), "Ball-2".to_string()]
+    );
     assert!(trace.iter().all(|l| l.t == 8.0 && l.kind == "ball-ball"));
     for (b, want) in balls.iter().zip(canonical) {
         assert_close(b.traj.velocity, want, 1e-12);
@@ -196,7 +208,10 @@ fn exact_graze_is_no_collision() {
 #[test]
 fn ball_sliding_along_a_cushion() {
     let (trace, balls) = run(&scenario("along_cushion"));
-    assert_eq!(events(&trace), vec![(29.0, "ball-cushion", "Ball-1", "Cushion-2")]);
+    assert_eq!(
+        events(&trace),
+        vec![(29.0, "ball-cushion", "Ball-1", "Cushion-2")]
+    );
     assert_eq!(balls[0].traj.velocity, v(0.0, -10.0));
     assert_eq!(balls[0].traj.position, v(10.0, 380.0));
 }
@@ -246,6 +261,13 @@ fn the_break_is_deterministic_and_conserves_energy() {
     assert_eq!(trace_a, trace_b);
     assert_eq!(balls_a, balls_b);
     // the cue ball strikes the apex ball first
-    assert_eq!(trace_a[0].objects, ["Ball-1".to_string(), "Ball-2".to_string()]);
-    assert!(trace_a.len() > 30, "the rack scatters: {} events", trace_a.len());
+    assert_eq!(
+        trace_a[0].objects,
+        ["Ball-1".to_string(), "Ball-2".to_string()]
+    );
+    assert!(
+        trace_a.len() > 30,
+        "the rack scatters: {} events",
+        trace_a.len()
+    );
 }

@@ -1,10 +1,10 @@
 //! The event-list engine (thesis fig. 2): the reference every other engine must reproduce.
 //!
 //! Each ball keeps only its own earliest predicted event (another ball, a fixed object, or leaving
-//! its grid cell), and a tournament tree over the balls yields the earliest of all in O(log N).
+//! its grid cell), and a calendar queue over the balls yields the earliest of all in O(1).
 //! When ball `i` changes velocity its counter goes up; an event whose partner's counter moved on is
 //! stale, and popping it merely recomputes its owner's next event. An event therefore costs a
-//! bounded number of pair tests (the 3 × 3 cells around each ball involved) and O(log N) tree
+//! bounded number of pair tests (the 3 × 3 cells around each ball involved) and O(1) queue
 //! work, never O(N).
 //!
 //! Order: events run by their virtual-time [`Key`]. A prediction is a pure function of the two
@@ -16,6 +16,7 @@
 //! event no later than `X`; if that event is popped stale, the ball recomputes and keeps one no
 //! later than `X` again. So the earliest valid event is never missed.
 
+use super::calendar::Calendar;
 use super::grid::Grid;
 use super::{BallState, Event, EventCounts, EventKind, Observer, Outcome, RunError, Table, World};
 use crate::geometry::Trajectory;
@@ -31,6 +32,22 @@ const CELL_CROSSING: Pair = u64::MAX;
 /// The most events one instant may hold before the run stops with [`RunError::Cascade`].
 pub const MAX_EVENTS_PER_INSTANT: u64 = 10_000_000;
 
+/// A ball's earliest predicted physical event (or the best candidate so far while predicting).
+#[derive(Clone, Debug)]
+struct Best {
+    key: Key,
+    partner: Partner,
+}
+
+impl Best {
+    fn none() -> Best {
+        Best {
+            key: Key::at(f64::INFINITY, 0),
+            partner: Partner::Nothing,
+        }
+    }
+}
+
 /// What a ball's next event is with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Partner {
@@ -40,79 +57,25 @@ enum Partner {
     Ball(u32, u32),
     /// A fixed object (global index).
     Fixed(u32),
-    /// The ball's centre enters this grid cell.
-    Cell(u32),
 }
 
-#[derive(Clone, Debug)]
-struct Next {
-    key: Key,
-    partner: Partner,
+/// The hot part of a ball's state, one cache line: what a neighbour's prediction reads.
+#[derive(Clone, Copy, Debug)]
+#[repr(align(64))]
+struct Slot {
+    /// Trajectory since the last velocity change (for a pocketed ball: its crossing of the line).
+    traj: Trajectory,
+    /// Radius.
+    radius: f64,
+    /// When the centre next leaves its grid cell (infinite: never).
+    cross_t: f64,
+    /// Goes up at every velocity change: events predicted with an older value are stale.
+    counter: u32,
+    /// The grid cell of the centre; `NOT_ON_TABLE` once pocketed.
+    cell: u32,
 }
 
-/// A complete binary tree over the balls' next-event times: each inner node holds the ball whose
-/// event is earliest below it.
-#[derive(Clone, Debug)]
-struct Tournament {
-    leaves: usize,
-    node: Vec<u32>,
-}
-
-impl Tournament {
-    fn new(n: usize) -> Tournament {
-        let leaves = n.next_power_of_two().max(1);
-        Tournament {
-            leaves,
-            node: vec![u32::MAX; 2 * leaves],
-        }
-    }
-
-    #[inline]
-    fn earlier(next: &[Next], a: u32, b: u32) -> u32 {
-        if b == u32::MAX {
-            return a;
-        }
-        if a == u32::MAX {
-            return b;
-        }
-        let (ka, kb) = (&next[a as usize].key, &next[b as usize].key);
-        match ka.t.total_cmp(&kb.t) {
-            Ordering::Less => a,
-            Ordering::Greater => b,
-            Ordering::Equal => {
-                if ka.path <= kb.path {
-                    a
-                } else {
-                    b
-                }
-            }
-        }
-    }
-
-    #[inline]
-    fn update(&mut self, next: &[Next], i: u32) {
-        let mut k = self.leaves + i as usize;
-        self.node[k] = i;
-        while k > 1 {
-            k /= 2;
-            self.node[k] = Self::earlier(next, self.node[2 * k], self.node[2 * k + 1]);
-        }
-    }
-
-    fn build(&mut self, next: &[Next]) {
-        for (i, _) in next.iter().enumerate() {
-            self.node[self.leaves + i] = i as u32;
-        }
-        for k in (1..self.leaves).rev() {
-            self.node[k] = Self::earlier(next, self.node[2 * k], self.node[2 * k + 1]);
-        }
-    }
-
-    #[inline]
-    fn top(&self) -> u32 {
-        self.node[1]
-    }
-}
+const NOT_ON_TABLE: u32 = u32::MAX;
 
 /// Counters an event-list run reports beside its events.
 #[derive(Clone, Copy, Debug, Default)]
@@ -130,11 +93,18 @@ pub struct Stats {
 /// The event-list engine over one scenario.
 pub struct EventList {
     table: Table,
-    balls: Vec<BallState>,
+    slots: Vec<Slot>,
+    mass: Vec<f64>,
+    pocket: Vec<Option<u32>>,
+    /// The key at which each ball's trajectory was fixed.
     fixed_at: Vec<Key>,
-    counter: Vec<u32>,
-    next: Vec<Next>,
-    tree: Tournament,
+    /// Each ball's earliest physical event.
+    phys: Vec<Best>,
+    /// The cell each ball's centre enters at `cross_t`.
+    cross_cell: Vec<u32>,
+    /// Each ball's queued key: the earlier of its physical event and its cell crossing.
+    keys: Vec<Key>,
+    queue: Calendar,
     grid: Grid,
     now: f64,
     stats: Stats,
@@ -163,28 +133,51 @@ impl EventList {
         let n = balls.len();
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
         let mut grid = Grid::new(&table, n, rmax, 2.0 * rmax * opts.cell_diameters.max(1.0));
-        for (i, b) in balls.iter().enumerate() {
-            grid.insert(i as u32, grid.cell_at(b.traj.position));
-        }
-        let idle = Next {
-            key: Key::at(f64::INFINITY, 0),
-            partner: Partner::Nothing,
-        };
+        let slots = balls
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let cell = grid.cell_at(b.traj.position);
+                grid.insert(i as u32, cell);
+                Slot {
+                    traj: b.traj,
+                    radius: b.radius,
+                    cross_t: f64::INFINITY,
+                    counter: 0,
+                    cell,
+                }
+            })
+            .collect();
         let mut e = EventList {
             table,
-            balls,
+            slots,
+            mass: balls.iter().map(|b| b.mass).collect(),
+            pocket: vec![None; n],
             fixed_at: vec![Key::start(0.0); n],
-            counter: vec![0; n],
-            next: vec![idle; n],
-            tree: Tournament::new(n),
+            phys: vec![Best::none(); n],
+            cross_cell: vec![0; n],
+            keys: vec![Key::at(f64::INFINITY, 0); n],
+            queue: Calendar::new(n, 0.0, 1.0),
             grid,
             now: 0.0,
             stats: Stats::default(),
         };
+        // First predictions go into a provisional calendar; the real one's bucket width comes
+        // from the mean time to each ball's first event (events then come about mean / n apart).
         for i in 0..n as u32 {
-            e.next[i as usize] = e.predict(i);
+            e.predict(i);
         }
-        e.tree.build(&e.next);
+        let finite: Vec<f64> = e
+            .keys
+            .iter()
+            .map(|k| k.t)
+            .filter(|t| t.is_finite())
+            .collect();
+        let mean = finite.iter().sum::<f64>() / finite.len().max(1) as f64;
+        e.queue = Calendar::new(n, 0.0, mean / finite.len().max(1) as f64);
+        for i in 0..n as u32 {
+            e.queue.set(&e.keys, i);
+        }
         e
     }
 
@@ -201,71 +194,45 @@ impl EventList {
     /// Bytes of memory held by the engine's own tables (not counting the scenario).
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
-        let n = self.balls.len();
-        n * (size_of::<BallState>() + size_of::<Key>() + 4 + size_of::<Next>())
-            + self.tree.node.len() * 4
+        let n = self.slots.len();
+        n * (size_of::<Slot>() + 8 + 8 + 2 * size_of::<Key>() + size_of::<Best>() + 4)
+            + self.queue.memory_bytes()
             + self.grid.memory_bytes()
     }
 
-    /// The earliest event of ball `i` from its current trajectory.
-    fn predict(&mut self, i: u32) -> Next {
-        let b = self.balls[i as usize];
-        if b.pocket.is_some() {
-            return Next {
-                key: Key::at(f64::INFINITY, 0),
-                partner: Partner::Nothing,
-            };
+    /// Offers the contact of ball `i` (slot `b`) with ball `j` to `best`.
+    #[inline]
+    fn offer_ball(&self, i: u32, b: &Slot, j: u32, best: &mut Best) {
+        let o = &self.slots[j as usize];
+        let contact = if i < j {
+            physics::ball_ball_contact(&b.traj, b.radius, &o.traj, o.radius)
+        } else {
+            physics::ball_ball_contact(&o.traj, o.radius, &b.traj, b.radius)
+        };
+        let p = pair(i, j);
+        match contact {
+            Contact::Never => {}
+            Contact::At(t) => {
+                if best.key.cmp_at(t, p) == Ordering::Greater {
+                    best.key = Key::at(t, p);
+                    best.partner = Partner::Ball(j, o.counter);
+                }
+            }
+            Contact::Immediate => {
+                let (fi, fj) = (&self.fixed_at[i as usize], &self.fixed_at[j as usize]);
+                let key = fi.max(fj).child(p);
+                if key < best.key {
+                    best.key = key;
+                    best.partner = Partner::Ball(j, o.counter);
+                }
+            }
         }
-        let Some(cell) = self.grid.cell_of(i) else {
-            unreachable!("a ball on the table is always in a cell")
-        };
-        let mut best = match self
-            .grid
-            .exit(cell, b.traj.position, b.traj.velocity, b.traj.t0)
-        {
-            Some((t, c)) => Next {
-                key: Key::at(t.max(self.now), CELL_CROSSING),
-                partner: Partner::Cell(c),
-            },
-            None => Next {
-                key: Key::at(f64::INFINITY, 0),
-                partner: Partner::Nothing,
-            },
-        };
-        let mut tests = 0u64;
-        let (balls, fixed_at, counter) = (&self.balls, &self.fixed_at, &self.counter);
-        self.grid.for_each_near(cell, |j| {
-            if j == i {
-                return;
-            }
-            tests += 1;
-            let o = &balls[j as usize];
-            let contact = if i < j {
-                physics::ball_ball_contact(&b.traj, b.radius, &o.traj, o.radius)
-            } else {
-                physics::ball_ball_contact(&o.traj, o.radius, &b.traj, b.radius)
-            };
-            let p = pair(i, j);
-            match contact {
-                Contact::Never => {}
-                Contact::At(t) => {
-                    if best.key.cmp_at(t, p) == Ordering::Greater {
-                        best.key = Key::at(t, p);
-                        best.partner = Partner::Ball(j, counter[j as usize]);
-                    }
-                }
-                Contact::Immediate => {
-                    let parent = fixed_at[i as usize].clone().max(fixed_at[j as usize].clone());
-                    let key = parent.child(p);
-                    if key < best.key {
-                        best.key = key;
-                        best.partner = Partner::Ball(j, counter[j as usize]);
-                    }
-                }
-            }
-        });
-        for &f in self.grid.fixed_near(cell) {
-            tests += 1;
+    }
+
+    /// Offers the contacts of ball `i` with the fixed objects near cell `cell` to `best`.
+    fn offer_fixed(&self, i: u32, b: &Slot, cell: u32, best: &mut Best) -> u64 {
+        let near = self.grid.fixed_near(cell);
+        for &f in near {
             let p = pair(i, f);
             match self.table.contact(f, &b.traj, b.radius) {
                 Contact::Never => {}
@@ -284,24 +251,89 @@ impl EventList {
                 }
             }
         }
-        self.stats.predictions += tests;
-        best
+        near.len() as u64
     }
 
-    fn repredict(&mut self, i: u32) {
-        self.next[i as usize] = self.predict(i);
-        self.tree.update(&self.next, i);
+    /// Recomputes ball `i`'s earliest physical event and its next cell crossing from scratch.
+    fn predict(&mut self, i: u32) {
+        let b = self.slots[i as usize];
+        let mut best = Best::none();
+        if b.cell != NOT_ON_TABLE {
+            let mut tests = 0u64;
+            self.grid.for_each_near(b.cell, |j| {
+                if j != i {
+                    tests += 1;
+                    self.offer_ball(i, &b, j, &mut best);
+                }
+            });
+            tests += self.offer_fixed(i, &b, b.cell, &mut best);
+            self.stats.predictions += tests;
+        }
+        self.phys[i as usize] = best;
+        self.set_exit(i);
+        self.requeue(i);
+    }
+
+    /// Ball `i`'s centre moves into cell `to`: only the balls of the cells that come into its
+    /// 3 × 3 block are new candidates; its physical prediction otherwise stands.
+    fn cross(&mut self, i: u32, to: u32) {
+        let from = self.slots[i as usize].cell;
+        self.grid.remove(i);
+        self.grid.insert(i, to);
+        self.slots[i as usize].cell = to;
+        let b = self.slots[i as usize];
+        let mut best = std::mem::replace(&mut self.phys[i as usize], Best::none());
+        let mut tests = 0u64;
+        self.grid.for_each_entering(from, to, |j| {
+            tests += 1;
+            self.offer_ball(i, &b, j, &mut best);
+        });
+        tests += self.offer_fixed(i, &b, to, &mut best);
+        self.stats.predictions += tests;
+        self.phys[i as usize] = best;
+        self.set_exit(i);
+        self.requeue(i);
+    }
+
+    /// Predicts when ball `i`'s centre leaves its cell, and which cell it enters.
+    fn set_exit(&mut self, i: u32) {
+        let b = &mut self.slots[i as usize];
+        let exit = if b.cell == NOT_ON_TABLE {
+            None
+        } else {
+            self.grid
+                .exit(b.cell, b.traj.position, b.traj.velocity, b.traj.t0)
+        };
+        match exit {
+            Some((t, c)) => {
+                b.cross_t = t.max(self.now);
+                self.cross_cell[i as usize] = c;
+            }
+            None => b.cross_t = f64::INFINITY,
+        }
+    }
+
+    /// Queues ball `i` at the earlier of its physical event and its cell crossing.
+    fn requeue(&mut self, i: u32) {
+        let t = self.slots[i as usize].cross_t;
+        let phys = &self.phys[i as usize].key;
+        self.keys[i as usize] = if phys.cmp_at(t, CELL_CROSSING) == Ordering::Greater {
+            Key::at(t, CELL_CROSSING)
+        } else {
+            phys.clone()
+        };
+        self.queue.set(&self.keys, i);
     }
 
     fn set_velocity(&mut self, i: u32, key: &Key, velocity: crate::geometry::Vec2) {
-        let b = &mut self.balls[i as usize];
+        let b = &mut self.slots[i as usize];
         b.traj = Trajectory {
             position: b.traj.at(key.t),
             velocity,
             t0: key.t,
         };
+        b.counter = b.counter.wrapping_add(1);
         self.fixed_at[i as usize] = key.clone();
-        self.counter[i as usize] = self.counter[i as usize].wrapping_add(1);
     }
 
     /// Runs until the next event would come after `until`, reporting each event to `obs`, and
@@ -326,61 +358,59 @@ impl EventList {
                 until = self.now;
                 break;
             }
-            let i = self.tree.top();
-            if i == u32::MAX {
+            let Some(i) = self.queue.first(&self.keys) else {
                 break;
-            }
-            let key = self.next[i as usize].key.clone();
-            if !(key.t <= until) {
+            };
+            let key = self.keys[i as usize].clone();
+            if key.t > until {
                 break;
             }
             self.now = key.t;
-            match self.next[i as usize].partner {
+            if key.path[..] == [CELL_CROSSING] {
+                self.stats.cell_crossings += 1;
+                self.cross(i, self.cross_cell[i as usize]);
+                continue;
+            }
+            match self.phys[i as usize].partner {
                 Partner::Nothing => break,
-                Partner::Cell(c) => {
-                    self.stats.cell_crossings += 1;
-                    self.grid.remove(i);
-                    self.grid.insert(i, c);
-                    self.repredict(i);
-                    continue;
-                }
-                Partner::Ball(j, seen) if self.counter[j as usize] != seen => {
+                Partner::Ball(j, seen) if self.slots[j as usize].counter != seen => {
                     self.stats.stale += 1;
-                    self.repredict(i);
+                    self.predict(i);
                     continue;
                 }
                 Partner::Ball(j, _) => {
                     let (a, b) = (i.min(j), i.max(j));
-                    let (ba, bb) = (self.balls[a as usize], self.balls[b as usize]);
+                    let (sa, sb) = (self.slots[a as usize], self.slots[b as usize]);
                     let (va, vb) = physics::ball_ball_velocities(
-                        ba.traj.at(key.t),
-                        ba.traj.velocity,
-                        ba.mass,
-                        bb.traj.at(key.t),
-                        bb.traj.velocity,
-                        bb.mass,
+                        sa.traj.at(key.t),
+                        sa.traj.velocity,
+                        self.mass[a as usize],
+                        sb.traj.at(key.t),
+                        sb.traj.velocity,
+                        self.mass[b as usize],
                     );
                     self.set_velocity(a, &key, va);
                     self.set_velocity(b, &key, vb);
-                    self.repredict(a);
-                    self.repredict(b);
+                    self.predict(a);
+                    self.predict(b);
                     self.emit(&key, EventKind::BallBall, a, b, &mut counts, obs)?;
                 }
                 Partner::Fixed(f) => {
-                    let b = self.balls[i as usize];
+                    let b = self.slots[i as usize];
                     let p = b.traj.at(key.t);
                     match self.table.bounce(f, p, b.traj.velocity) {
                         Some(v) => self.set_velocity(i, &key, v),
                         None => {
                             self.set_velocity(i, &key, b.traj.velocity);
-                            let crate::engine::Fixed::Pocket(k) = self.table.fixed(f) else {
+                            let super::Fixed::Pocket(k) = self.table.fixed(f) else {
                                 unreachable!("only pockets swallow balls")
                             };
-                            self.balls[i as usize].pocket = Some(k);
+                            self.pocket[i as usize] = Some(k);
                             self.grid.remove(i);
+                            self.slots[i as usize].cell = NOT_ON_TABLE;
                         }
                     }
-                    self.repredict(i);
+                    self.predict(i);
                     let kind = self.table.event_kind(f);
                     self.emit(&key, kind, i, f, &mut counts, obs)?;
                 }
@@ -422,15 +452,22 @@ impl EventList {
     ) -> Result<(), RunError> {
         counts.add(kind);
         self.stats.max_depth = self.stats.max_depth.max(key.depth());
-        obs.on_event(&Event { t: key.t, kind, a, b }, self)
+        obs.on_event(
+            &Event {
+                t: key.t,
+                kind,
+                a,
+                b,
+            },
+            self,
+        )
     }
 
     /// Every ball's state fixed at time `t` (not before the last event).
     pub fn state_at(&self, t: f64) -> Vec<BallState> {
-        self.balls
-            .iter()
-            .map(|b| {
-                let mut b = *b;
+        (0..self.slots.len() as u32)
+            .map(|i| {
+                let mut b = self.ball(i);
                 if b.pocket.is_none() {
                     b.traj = Trajectory {
                         position: b.traj.at(t),
@@ -449,12 +486,23 @@ impl World for EventList {
         &self.table
     }
 
-    fn balls(&self) -> &[BallState] {
-        &self.balls
+    fn n_balls(&self) -> usize {
+        self.slots.len()
+    }
+
+    fn ball(&self, i: u32) -> BallState {
+        let s = &self.slots[i as usize];
+        BallState {
+            traj: s.traj,
+            radius: s.radius,
+            mass: self.mass[i as usize],
+            pocket: self.pocket[i as usize],
+        }
     }
 
     fn for_each_neighbor(&self, i: u32, f: &mut dyn FnMut(u32)) {
-        if let Some(c) = self.grid.cell_of(i) {
+        let c = self.slots[i as usize].cell;
+        if c != NOT_ON_TABLE {
             self.grid.for_each_near(c, |j| {
                 if j != i {
                     f(j)

@@ -3,9 +3,11 @@
 //! Cells are at least a ball diameter wide (with a small margin), and a ball belongs to the cell
 //! holding its centre, so any two touching balls sit in the same or adjacent cells. The outermost
 //! cells reach out to infinity: a ball that leaves the table's box stays in its edge cell and the
-//! neighbourhood rule still holds. Balls of a cell form an intrusive doubly linked list (no
-//! allocation per cell, O(1) moves); fixed objects are listed once per cell they may reach, in
-//! compressed rows.
+//! neighbourhood rule still holds. Each cell stores its balls' indices inline in a fixed number of
+//! slots, so the 3 × 3 block around a ball is read from three short runs of memory and the balls'
+//! own records can then be fetched in parallel (a linked list would chain one cache miss after
+//! another); when a cell fills up, every cell gets twice the slots. Fixed objects are listed once
+//! per cell they may reach, in compressed rows.
 
 use super::Table;
 use crate::geometry::Vec2;
@@ -25,9 +27,9 @@ pub struct Grid {
     height: f64,
     nx: u32,
     ny: u32,
-    head: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
+    cap: usize,
+    slots: Vec<u32>,
+    len: Vec<u8>,
     cell_of: Vec<u32>,
     fixed_start: Vec<u32>,
     fixed_items: Vec<u32>,
@@ -41,8 +43,8 @@ impl Grid {
         let span = table.hi - table.lo;
         let w_min = (2.0 * rmax * CELL_MARGIN).max(min_cell);
         let cap = (4 * n).max(16) as f64;
-        let mut nx = ((span.x / w_min).floor().max(1.0)).min(1e6);
-        let mut ny = ((span.y / w_min).floor().max(1.0)).min(1e6);
+        let mut nx = (span.x / w_min).floor().clamp(1.0, 1e6);
+        let mut ny = (span.y / w_min).floor().clamp(1.0, 1e6);
         while nx * ny > cap {
             nx = (nx / 2.0).floor().max(1.0);
             ny = (ny / 2.0).floor().max(1.0);
@@ -54,14 +56,14 @@ impl Grid {
             height: span.y / f64::from(ny),
             nx,
             ny,
-            head: vec![NIL; (nx * ny) as usize],
-            next: vec![NIL; n],
-            prev: vec![NIL; n],
+            cap: 4,
+            slots: vec![NIL; 4 * (nx * ny) as usize],
+            len: vec![0; (nx * ny) as usize],
             cell_of: vec![NIL; n],
             fixed_start: Vec::new(),
             fixed_items: Vec::new(),
         };
-        if !(g.width > 0.0) || !(g.height > 0.0) {
+        if g.width.is_nan() || g.width <= 0.0 || g.height.is_nan() || g.height <= 0.0 {
             g.width = w_min;
             g.height = w_min;
         }
@@ -136,14 +138,28 @@ impl Grid {
     /// Puts ball `i` into cell `c`.
     #[inline]
     pub fn insert(&mut self, i: u32, c: u32) {
-        let h = self.head[c as usize];
-        self.next[i as usize] = h;
-        self.prev[i as usize] = NIL;
-        if h != NIL {
-            self.prev[h as usize] = i;
+        let c = c as usize;
+        if usize::from(self.len[c]) == self.cap {
+            self.grow();
         }
-        self.head[c as usize] = i;
-        self.cell_of[i as usize] = c;
+        let k = usize::from(self.len[c]);
+        self.slots[c * self.cap + k] = i;
+        self.len[c] += 1;
+        self.cell_of[i as usize] = c as u32;
+    }
+
+    /// Doubles every cell's slots (a cell overflowed: balls of very different sizes).
+    fn grow(&mut self) {
+        let cap = 2 * self.cap;
+        assert!(cap <= 128, "more than 128 ball centres in one grid cell");
+        let mut slots = vec![NIL; cap * self.len.len()];
+        for (c, &n) in self.len.iter().enumerate() {
+            let n = usize::from(n);
+            slots[c * cap..c * cap + n]
+                .copy_from_slice(&self.slots[c * self.cap..c * self.cap + n]);
+        }
+        self.slots = slots;
+        self.cap = cap;
     }
 
     /// Takes ball `i` out of its cell.
@@ -153,15 +169,16 @@ impl Grid {
         if c == NIL {
             return;
         }
-        let (p, n) = (self.prev[i as usize], self.next[i as usize]);
-        if p == NIL {
-            self.head[c as usize] = n;
-        } else {
-            self.next[p as usize] = n;
-        }
-        if n != NIL {
-            self.prev[n as usize] = p;
-        }
+        let c = c as usize;
+        let n = usize::from(self.len[c]);
+        let cell = &mut self.slots[c * self.cap..c * self.cap + n];
+        let k = cell
+            .iter()
+            .position(|&j| j == i)
+            .expect("a ball is in the cell it was put in");
+        cell[k] = cell[n - 1];
+        cell[n - 1] = NIL;
+        self.len[c] -= 1;
         self.cell_of[i as usize] = NIL;
     }
 
@@ -175,12 +192,31 @@ impl Grid {
         let y0 = cy.saturating_sub(1);
         let y1 = (cy + 1).min(self.ny - 1);
         for y in y0..=y1 {
-            let row = y * self.nx;
-            for x in x0..=x1 {
-                let mut j = self.head[(row + x) as usize];
-                while j != NIL {
+            let row = (y * self.nx) as usize;
+            for c in row + x0 as usize..=row + x1 as usize {
+                let n = usize::from(self.len[c]);
+                for &j in &self.slots[c * self.cap..c * self.cap + n] {
                     f(j);
-                    j = self.next[j as usize];
+                }
+            }
+        }
+    }
+
+    /// Calls `f` with every ball in the cells of the 3 × 3 block around `to` that are not in the
+    /// block around `from` (a ball whose centre moved from `from` to `to`).
+    #[inline]
+    pub fn for_each_entering(&self, from: u32, to: u32, mut f: impl FnMut(u32)) {
+        let (fx, fy) = ((from % self.nx) as i64, (from / self.nx) as i64);
+        let (tx, ty) = (to % self.nx, to / self.nx);
+        for y in ty.saturating_sub(1)..=(ty + 1).min(self.ny - 1) {
+            for x in tx.saturating_sub(1)..=(tx + 1).min(self.nx - 1) {
+                if (i64::from(x) - fx).abs() <= 1 && (i64::from(y) - fy).abs() <= 1 {
+                    continue;
+                }
+                let c = (y * self.nx + x) as usize;
+                let n = usize::from(self.len[c]);
+                for &j in &self.slots[c * self.cap..c * self.cap + n] {
+                    f(j);
                 }
             }
         }
@@ -226,11 +262,10 @@ impl Grid {
 
     /// Bytes of memory the grid holds.
     pub fn memory_bytes(&self) -> usize {
-        4 * (self.head.len()
-            + self.next.len()
-            + self.prev.len()
+        4 * (self.slots.len()
             + self.cell_of.len()
             + self.fixed_start.len()
             + self.fixed_items.len())
+            + self.len.len()
     }
 }

@@ -5,6 +5,7 @@
 //! the numbering of all objects) and a vector of [`BallState`]s, and reports each physical event it
 //! executes, in execution order, to an [`Observer`]. Engines write no files: sinks do.
 
+pub mod calendar;
 pub mod event_list;
 pub mod grid;
 pub mod time_step;
@@ -103,12 +104,7 @@ impl Table {
                 .collect(),
             pockets: s.pockets.iter().map(|p| (p.from, p.to)).collect(),
             corners: (0..s.corner_count())
-                .map(|k| {
-                    (
-                        s.corner_position(k),
-                        s.pockets[k / 2].corner_elasticity,
-                    )
-                })
+                .map(|k| (s.corner_position(k), s.pockets[k / 2].corner_elasticity))
                 .collect(),
             lo,
             hi,
@@ -279,8 +275,10 @@ impl BallState {
 pub trait World {
     /// The table.
     fn table(&self) -> &Table;
-    /// Every ball's state.
-    fn balls(&self) -> &[BallState];
+    /// Number of balls.
+    fn n_balls(&self) -> usize;
+    /// Ball `i`'s current state.
+    fn ball(&self, i: u32) -> BallState;
     /// Calls `f` with every ball that might touch ball `i` now (a superset is fine).
     fn for_each_neighbor(&self, i: u32, f: &mut dyn FnMut(u32));
 }

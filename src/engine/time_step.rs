@@ -263,7 +263,10 @@ impl TimeStep {
                 ("max_overlap_fraction_of_radius", s.max_overlap),
                 ("mean_detection_delay", mean_late),
                 ("max_detection_delay", s.max_lateness),
-                ("overlapping_separating_pairs", s.overlapping_separating as f64),
+                (
+                    "overlapping_separating_pairs",
+                    s.overlapping_separating as f64,
+                ),
             ],
         })
     }
@@ -291,8 +294,12 @@ impl World for TimeStep {
         &self.table
     }
 
-    fn balls(&self) -> &[BallState] {
-        &self.balls
+    fn n_balls(&self) -> usize {
+        self.balls.len()
+    }
+
+    fn ball(&self, i: u32) -> BallState {
+        self.balls[i as usize]
     }
 
     fn for_each_neighbor(&self, i: u32, f: &mut dyn FnMut(u32)) {

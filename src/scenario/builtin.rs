@@ -289,7 +289,7 @@ fn plate1(p: &Params) -> Result<Scenario, Invalid> {
 /// The integer `k` with `k * k == n`, if there is one.
 fn exact_sqrt(n: usize) -> Option<usize> {
     let mut k = (n as f64).sqrt() as usize;
-    while k.checked_mul(k).map_or(true, |kk| kk > n) {
+    while k.checked_mul(k).is_none_or(|kk| kk > n) {
         k -= 1;
     }
     while (k + 1).checked_mul(k + 1).is_some_and(|kk| kk <= n) {
@@ -535,4 +535,364 @@ fn cradle(p: &Params) -> Result<Scenario, Invalid> {
         pockets: Vec::new(),
         sectors: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names() -> Vec<&'static str> {
+        list().into_iter().map(|(n, _)| n).collect()
+    }
+
+    fn gas_with(balls: usize, seed: u64, phi: Option<f64>) -> Result<Scenario, Invalid> {
+        build(
+            "gas",
+            &Params {
+                balls: Some(balls),
+                seed: Some(seed),
+                area_fraction: phi,
+                ..Params::default()
+            },
+        )
+    }
+
+    #[test]
+    fn every_builtin_builds_validates_and_is_named() {
+        assert_eq!(names(), ["plate1", "gas", "reversal", "pool", "cradle"]);
+        for (name, description) in list() {
+            assert!(!description.is_empty() && !description.contains('\n'));
+            let s = build(name, &Params::default()).unwrap();
+            s.validate().unwrap();
+            assert_eq!(s.name, name);
+            assert!(!s.balls.is_empty() && !s.cushions.is_empty());
+        }
+    }
+
+    #[test]
+    fn every_side_has_the_table_on_its_right() {
+        for name in names() {
+            let s = build(name, &Params::default()).unwrap();
+            let ends: Vec<Vec2> = s
+                .cushions
+                .iter()
+                .flat_map(|c| [c.from, c.to])
+                .chain(s.pockets.iter().flat_map(|p| [p.from, p.to]))
+                .collect();
+            let sum = ends.iter().fold(Vec2::ZERO, |a, &b| a + b);
+            let centroid = (1.0 / ends.len() as f64) * sum;
+            let sides = s
+                .cushions
+                .iter()
+                .map(|c| (c.from, c.to))
+                .chain(s.pockets.iter().map(|p| (p.from, p.to)));
+            for (k, (from, to)) in sides.enumerate() {
+                let mid = 0.5 * (from + to);
+                let inward = (to - from).perp_cw();
+                assert!(
+                    inward.dot(centroid - mid) > 0.0,
+                    "{name}: side {k} from {from:?} to {to:?} faces away from the table"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn plate1_is_the_thesis_picture() {
+        let s = build("plate1", &Params::default()).unwrap();
+        assert_eq!(s.until, 3.0);
+        assert_eq!(s.cushions.len(), 5);
+        assert_eq!(s.pockets.len(), 1);
+        assert_eq!(s.pockets[0].from, Vec2::new(270.0, 400.0));
+        assert_eq!(s.pockets[0].to, Vec2::new(330.0, 400.0));
+        assert_eq!(s.balls[0].position, Vec2::new(300.0, 300.0));
+        assert_eq!(s.balls[0].velocity, Vec2::ZERO);
+        assert_eq!(s.balls[1].position, Vec2::new(300.0, 100.0));
+        assert_eq!(s.balls[1].velocity, Vec2::new(0.0, 100.0));
+        // Ball-2 closes the 160 gap at speed 100: contact at t = 1.6; Ball-1 then has 100 to go.
+        let gap = s.balls[0].position.y - s.balls[1].position.y - 40.0;
+        assert_eq!(gap / 100.0, 1.6);
+    }
+
+    #[test]
+    fn gas_defaults_follow_the_thesis() {
+        let s = build("gas", &Params::default()).unwrap();
+        assert_eq!(s.balls.len(), 36);
+        assert_eq!(s.bounds(), (Vec2::ZERO, Vec2::new(600.0, 600.0)));
+        assert_eq!(s.balls[0].position, Vec2::new(50.0, 50.0));
+        assert_eq!(s.balls[1].position, Vec2::new(150.0, 50.0));
+        assert_eq!(s.balls[6].position, Vec2::new(50.0, 150.0));
+        assert!(s.pockets.is_empty());
+        assert_eq!(s.until, 4.0);
+        for b in &s.balls {
+            assert_eq!((b.radius, b.mass), (30.0, 1.0));
+            assert!(b.velocity.norm() < 100.0);
+        }
+    }
+
+    #[test]
+    fn gas_seed_is_deterministic() {
+        let a = gas_with(400, 3, None).unwrap();
+        let b = gas_with(400, 3, None).unwrap();
+        let c = gas_with(400, 4, None).unwrap();
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        assert_eq!(a.balls.len(), 400);
+        let positions = |s: &Scenario| s.balls.iter().map(|b| b.position).collect::<Vec<_>>();
+        assert_eq!(positions(&a), positions(&c));
+    }
+
+    #[test]
+    fn seeded_velocities_are_pinned() {
+        // These bits must never change, on any platform: a seed names one scenario.
+        let s = build("reversal", &Params::default()).unwrap();
+        let v = s.balls[0].velocity;
+        let again = {
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            random_velocity(&mut rng, 100.0)
+        };
+        assert_eq!(v, again);
+        assert_eq!((v.x.to_bits(), v.y.to_bits()), PINNED_REVERSAL_BALL1);
+    }
+
+    const PINNED_REVERSAL_BALL1: (u64, u64) = (13854089065394845240, 4621270761056742218);
+
+    #[test]
+    fn velocities_are_spread_in_speed_and_direction() {
+        let s = gas_with(10_000, 7, Some(0.3)).unwrap();
+        let n = s.balls.len() as f64;
+        let mean_speed = s.balls.iter().map(|b| b.velocity.norm()).sum::<f64>() / n;
+        assert!((mean_speed - 50.0).abs() < 1.5, "{mean_speed}");
+        let mean_v = s.balls.iter().fold(Vec2::ZERO, |a, b| a + b.velocity);
+        assert!((1.0 / n * mean_v).norm() < 1.5);
+        let right = s.balls.iter().filter(|b| b.velocity.x > 0.0).count() as f64;
+        assert!((right / n - 0.5).abs() < 0.02);
+    }
+
+    #[test]
+    fn dense_gas_uses_a_triangular_lattice() {
+        let s = gas_with(900, 1, Some(0.85)).unwrap();
+        s.validate().unwrap();
+        assert_eq!(s.balls.len(), 900);
+        let mut xs: Vec<u64> = s.balls.iter().map(|b| b.position.x.to_bits()).collect();
+        xs.sort_unstable();
+        xs.dedup();
+        assert!(
+            xs.len() > 30,
+            "{} columns: not a triangular lattice",
+            xs.len()
+        );
+        // Rows are offset by half a spacing.
+        let d = s.balls[1].position.x - s.balls[0].position.x;
+        let m = s
+            .balls
+            .iter()
+            .position(|b| b.position.y > s.balls[0].position.y)
+            .unwrap();
+        assert!((s.balls[m].position.x - s.balls[0].position.x - d / 2.0).abs() < 1e-9 * d);
+        let area: f64 = s.balls.iter().map(|b| PI * b.radius * b.radius).sum();
+        let (lo, hi) = s.bounds();
+        assert!((area / ((hi.x - lo.x) * (hi.y - lo.y)) - 0.85).abs() < 1e-12);
+    }
+
+    #[test]
+    fn too_dense_gas_names_the_largest_fraction() {
+        let e = gas_with(400, 1, Some(0.95)).unwrap_err();
+        assert_eq!(e.field, "--area-fraction");
+        let best: f64 = e.message.rsplit(' ').next().unwrap().parse().unwrap();
+        assert!(best > 0.8 && best < 0.9069, "{}", e.message);
+        gas_with(400, 1, Some(best)).unwrap();
+        let e = build(
+            "gas",
+            &Params {
+                radius: Some(60.0),
+                ..Params::default()
+            },
+        )
+        .unwrap_err();
+        assert_eq!(e.field, "--radius");
+        assert!(
+            e.message.contains("--area-fraction at most"),
+            "{}",
+            e.message
+        );
+        for n in [1, 4, 9, 16, 25, 100] {
+            let e = gas_with(n, 1, Some(0.99)).unwrap_err();
+            let best: f64 = e.message.rsplit(' ').next().unwrap().parse().unwrap();
+            gas_with(n, 1, Some(best)).unwrap();
+        }
+    }
+
+    #[test]
+    fn gas_balls_must_be_a_square() {
+        let e = gas_with(10, 1, None).unwrap_err();
+        assert_eq!(e.field, "--balls");
+        assert!(e.message.contains("square number"), "{}", e.message);
+        assert!(e.message.contains("got 10"), "{}", e.message);
+        assert_eq!(gas_with(0, 1, None).unwrap_err().field, "--balls");
+        assert_eq!(gas_with(usize::MAX, 1, None).unwrap_err().field, "--balls");
+        assert_eq!(gas_with(1, 1, None).unwrap().balls.len(), 1);
+    }
+
+    #[test]
+    fn bad_parameter_values_name_their_flag() {
+        let cases = [
+            (
+                Params {
+                    area_fraction: Some(1.0),
+                    ..Params::default()
+                },
+                "--area-fraction",
+            ),
+            (
+                Params {
+                    area_fraction: Some(f64::NAN),
+                    ..Params::default()
+                },
+                "--area-fraction",
+            ),
+            (
+                Params {
+                    area_fraction: Some(1e-320),
+                    ..Params::default()
+                },
+                "--area-fraction",
+            ),
+            (
+                Params {
+                    radius: Some(-1.0),
+                    ..Params::default()
+                },
+                "--radius",
+            ),
+            (
+                Params {
+                    speed_max: Some(f64::INFINITY),
+                    ..Params::default()
+                },
+                "--speed-max",
+            ),
+        ];
+        for (p, flag) in cases {
+            assert_eq!(build("gas", &p).unwrap_err().field, flag, "{p:?}");
+        }
+        let still = build(
+            "gas",
+            &Params {
+                speed_max: Some(0.0),
+                ..Params::default()
+            },
+        )
+        .unwrap();
+        assert!(still.balls.iter().all(|b| b.velocity == Vec2::ZERO));
+    }
+
+    #[test]
+    fn parameters_a_scenario_does_not_take_are_refused() {
+        let phi = Params {
+            area_fraction: Some(0.5),
+            ..Params::default()
+        };
+        for name in ["plate1", "pool", "cradle", "reversal"] {
+            let e = build(name, &phi).unwrap_err();
+            assert_eq!(e.field, "--area-fraction", "{name}");
+            assert!(e.message.contains(name));
+        }
+        let seed = Params {
+            seed: Some(2),
+            ..Params::default()
+        };
+        assert_eq!(build("pool", &seed).unwrap_err().field, "--seed");
+        let balls = Params {
+            balls: Some(16),
+            ..Params::default()
+        };
+        assert_eq!(build("reversal", &balls).unwrap_err().field, "--balls");
+        let s = build("reversal", &seed).unwrap();
+        assert_ne!(s, build("reversal", &Params::default()).unwrap());
+    }
+
+    #[test]
+    fn unknown_name_lists_the_known_ones() {
+        let e = build("snooker", &Params::default()).unwrap_err();
+        assert_eq!(e.field, "scenario");
+        for name in names() {
+            assert!(e.message.contains(name), "{}", e.message);
+        }
+    }
+
+    #[test]
+    fn reversal_is_a_four_by_four_array() {
+        let s = build("reversal", &Params::default()).unwrap();
+        assert_eq!(s.balls.len(), 16);
+        assert_eq!(s.balls[5].position, Vec2::new(150.0, 150.0));
+        assert_eq!(s.bounds(), (Vec2::ZERO, Vec2::new(400.0, 400.0)));
+        assert_eq!(s.until, 3.0);
+        assert!(s.balls.iter().all(|b| b.radius == 30.0));
+    }
+
+    #[test]
+    fn pool_rack_touches() {
+        let s = build("pool", &Params::default()).unwrap();
+        assert_eq!(
+            (s.balls.len(), s.cushions.len(), s.pockets.len()),
+            (16, 6, 6)
+        );
+        assert_eq!(s.cushions[0].from, Vec2::new(0.0, 3.25));
+        assert_eq!(s.pockets[0].to, Vec2::new(3.25, 50.0));
+        assert_eq!(s.pockets[1].from, Vec2::new(47.5, 50.0));
+        assert_eq!(s.balls[0].velocity, Vec2::new(400.0, 0.0));
+        assert_eq!(s.balls[1].position, Vec2::new(75.0, 25.0));
+        // The table is closed: each side ends where the next begins, cushions and pockets
+        // alternating clockwise.
+        for k in 0..6 {
+            assert_eq!(s.cushions[k].to, s.pockets[k].from);
+            assert_eq!(s.pockets[k].to, s.cushions[(k + 1) % 6].from);
+        }
+        // Every rack ball touches at least two others.
+        let rack = &s.balls[1..];
+        for (i, a) in rack.iter().enumerate() {
+            let touching = rack
+                .iter()
+                .enumerate()
+                .filter(|&(j, b)| j != i && ((a.position - b.position).norm() - 2.25).abs() < 1e-9)
+                .count();
+            assert!(touching >= 2, "Ball-{} touches {touching}", i + 2);
+        }
+    }
+
+    #[test]
+    fn cradle_row_touches() {
+        let s = build("cradle", &Params::default()).unwrap();
+        assert_eq!(s.balls.len(), 6);
+        for i in 0..4 {
+            assert_eq!(s.balls[i + 1].position.x - s.balls[i].position.x, 20.0);
+        }
+        assert_eq!(s.balls[5].position, Vec2::new(300.0, 100.0));
+        assert_eq!(s.balls[5].velocity, Vec2::new(100.0, 0.0));
+    }
+
+    #[test]
+    fn large_gas_builds_quickly() {
+        let start = std::time::Instant::now();
+        let s = gas_with(250_000, 1, Some(0.6)).unwrap();
+        assert_eq!(s.balls.len(), 250_000);
+        let dense = gas_with(250_000, 1, Some(0.85)).unwrap();
+        assert_eq!(dense.balls.len(), 250_000);
+        assert!(
+            start.elapsed().as_secs_f64() < 20.0,
+            "{:?}",
+            start.elapsed()
+        );
+    }
+
+    #[test]
+    fn exact_square_roots() {
+        assert_eq!(exact_sqrt(1), Some(1));
+        assert_eq!(exact_sqrt(36), Some(6));
+        assert_eq!(exact_sqrt(35), None);
+        assert_eq!(exact_sqrt(1_000_000), Some(1000));
+        assert_eq!(exact_sqrt(usize::MAX), None);
+        assert_eq!(exact_sqrt(0), Some(0));
+    }
 }

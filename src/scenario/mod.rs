@@ -126,7 +126,10 @@ fn check_finite(field: &str, v: f64) -> Result<(), Invalid> {
     if v.is_finite() {
         Ok(())
     } else {
-        Err(invalid(field.into(), format!("must be a finite number, got {v}")))
+        Err(invalid(
+            field.into(),
+            format!("must be a finite number, got {v}"),
+        ))
     }
 }
 
@@ -155,7 +158,10 @@ fn check_elasticity(field: &str, v: f64) -> Result<(), Invalid> {
     if (0.0..=1.0).contains(&v) {
         Ok(())
     } else {
-        Err(invalid(field.into(), format!("must lie in [0, 1], got {v}")))
+        Err(invalid(
+            field.into(),
+            format!("must lie in [0, 1], got {v}"),
+        ))
     }
 }
 
@@ -181,7 +187,7 @@ impl Scenario {
     /// The position of corner `k` (0-based): pocket `k / 2`'s `from` end for even `k`, `to` for odd.
     pub fn corner_position(&self, k: usize) -> Vec2 {
         let p = &self.pockets[k / 2];
-        if k % 2 == 0 {
+        if k.is_multiple_of(2) {
             p.from
         } else {
             p.to
@@ -253,32 +259,48 @@ impl Scenario {
     }
 
     fn check_overlaps(&self) -> Result<(), Invalid> {
+        // Bucket the centres in square cells one largest diameter wide: overlapping balls sit in
+        // the same or adjacent cells. Sorting the buckets keeps this O(N log N) for any layout.
         let rmax = self.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let mut order: Vec<usize> = (0..self.balls.len()).collect();
-        order.sort_by(|&a, &b| self.balls[a].position.x.total_cmp(&self.balls[b].position.x));
-        for (k, &i) in order.iter().enumerate() {
-            let bi = &self.balls[i];
-            for &j in &order[k + 1..] {
+        let w = 2.0 * rmax;
+        let cell = |p: Vec2| ((p.y / w).floor() as i64, (p.x / w).floor() as i64);
+        let mut sorted: Vec<((i64, i64), usize)> = self
+            .balls
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (cell(b.position), i))
+            .collect();
+        sorted.sort_unstable();
+        for (i, bi) in self.balls.iter().enumerate() {
+            let (cy, cx) = cell(bi.position);
+            let mut worst: Option<usize> = None;
+            for y in cy - 1..=cy + 1 {
+                let lo = sorted.partition_point(|e| e.0 < (y, cx - 1));
+                let hi = sorted.partition_point(|e| e.0 <= (y, cx + 1));
+                for &(_, j) in &sorted[lo..hi] {
+                    if j <= i {
+                        continue;
+                    }
+                    let bj = &self.balls[j];
+                    let sigma = bi.radius + bj.radius;
+                    // Touching is allowed (a rack, a cradle); overlap beyond rounding is not.
+                    if (bj.position - bi.position).norm2() < sigma * sigma * (1.0 - 1e-12) {
+                        worst = Some(worst.map_or(j, |w| w.min(j)));
+                    }
+                }
+            }
+            if let Some(j) = worst {
                 let bj = &self.balls[j];
-                if bj.position.x - bi.position.x > bi.radius + rmax {
-                    break;
-                }
-                let sigma = bi.radius + bj.radius;
-                let d2 = (bj.position - bi.position).norm2();
-                // Touching is allowed (a rack, a cradle); overlap beyond rounding is not.
-                if d2 < sigma * sigma * (1.0 - 1e-12) {
-                    let (lo, hi) = (i.min(j), i.max(j));
-                    return Err(invalid(
-                        format!("ball[{}].position", hi + 1),
-                        format!(
-                            "Ball-{} overlaps Ball-{} at t = 0 (centres {:.6} apart, radii sum {})",
-                            hi + 1,
-                            lo + 1,
-                            d2.sqrt(),
-                            sigma
-                        ),
-                    ));
-                }
+                return Err(invalid(
+                    format!("ball[{}].position", j + 1),
+                    format!(
+                        "Ball-{} overlaps Ball-{} at t = 0 (centres {:.6} apart, radii sum {})",
+                        j + 1,
+                        i + 1,
+                        (bj.position - bi.position).norm(),
+                        bi.radius + bj.radius
+                    ),
+                ));
             }
         }
         Ok(())

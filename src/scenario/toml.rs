@@ -46,15 +46,13 @@ pub const DEFAULT_UNTIL: f64 = 4.0;
 /// 1-based line of the offending field where one can be found.
 pub fn parse(text: &str, source: &str) -> Result<Scenario, ScenarioError> {
     let raw: RawFile = ::toml::from_str(text).map_err(|e| toml_error(text, source, &e))?;
-    let scenario = raw
-        .to_scenario(source)
-        .map_err(|(inv, span)| {
-            let mut e = located(text, source, span, inv);
-            if e.line.is_none() {
-                e.line = header_line(text, "sectors");
-            }
-            e
-        })?;
+    let scenario = raw.to_scenario(source).map_err(|(inv, span)| {
+        let mut e = located(text, source, span, inv);
+        if e.line.is_none() {
+            e.line = header_line(text, "sectors");
+        }
+        e
+    })?;
     scenario.validate().map_err(|inv| {
         let span = raw.span_of(&inv.field);
         located(text, source, span, inv)
@@ -206,7 +204,10 @@ impl RawFile {
                 let b = b.get_ref();
                 BallSpec {
                     position: b.position.get_ref().vec(),
-                    velocity: b.velocity.as_ref().map_or(Vec2::ZERO, |v| v.get_ref().vec()),
+                    velocity: b
+                        .velocity
+                        .as_ref()
+                        .map_or(Vec2::ZERO, |v| v.get_ref().vec()),
                     radius: *b.radius.get_ref(),
                     mass: opt(&b.mass, 1.0),
                 }
@@ -257,7 +258,14 @@ impl RawFile {
                 (None, Some(polys)) if !polys.is_empty() => SectorSpec::Polygons(
                     polys
                         .iter()
-                        .map(|p| p.get_ref().points.get_ref().iter().map(|q| q.vec()).collect())
+                        .map(|p| {
+                            p.get_ref()
+                                .points
+                                .get_ref()
+                                .iter()
+                                .map(|q| q.vec())
+                                .collect()
+                        })
                         .collect(),
                 ),
                 (None, _) => {
@@ -325,9 +333,7 @@ impl RawFile {
                     let s = match rest {
                         Some("from") => Some(span(&p.from)),
                         Some("to") => Some(span(&p.to)),
-                        Some("elasticity" | "corner_elasticity") => {
-                            p.elasticity.as_ref().map(span)
-                        }
+                        Some("elasticity" | "corner_elasticity") => p.elasticity.as_ref().map(span),
                         _ => None,
                     };
                     s.or_else(|| Some(e.span()))
@@ -367,7 +373,11 @@ impl RawFile {
 /// The 1-based line holding byte `offset` of `text` (an offset past the end counts as the end).
 fn line_of(text: &str, offset: usize) -> usize {
     let end = offset.min(text.len());
-    text.as_bytes()[..end].iter().filter(|&&c| c == b'\n').count() + 1
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&c| c == b'\n')
+        .count()
+        + 1
 }
 
 /// Joins a possibly multi-line message into one line.
@@ -606,10 +616,12 @@ fn field_at(text: &str, offset: usize) -> String {
 
 /// The 1-based line of the header `[name]`, if the text has one.
 fn header_line(text: &str, name: &str) -> Option<usize> {
-    scan(text, text.len()).into_iter().find_map(|item| match item {
-        Item::Header { start, name: n, .. } if n == name => Some(line_of(text, start)),
-        _ => None,
-    })
+    scan(text, text.len())
+        .into_iter()
+        .find_map(|item| match item {
+            Item::Header { start, name: n, .. } if n == name => Some(line_of(text, start)),
+            _ => None,
+        })
 }
 
 #[cfg(test)]
@@ -793,7 +805,12 @@ grid = [2, 3]
     #[test]
     fn elasticity_above_one() {
         let e = fails(&with_line(20, "elasticity = 1.5"));
-        assert_error(&e, 20, "cushion[2].elasticity", "must lie in [0, 1], got 1.5");
+        assert_error(
+            &e,
+            20,
+            "cushion[2].elasticity",
+            "must lie in [0, 1], got 1.5",
+        );
     }
 
     #[test]
@@ -827,7 +844,12 @@ grid = [2, 3]
     #[test]
     fn wrong_types() {
         let e = fails(&with_line(7, "radius = \"big\""));
-        assert_error(&e, 7, "ball[1].radius", "invalid type: string \"big\", expected f64");
+        assert_error(
+            &e,
+            7,
+            "ball[1].radius",
+            "invalid type: string \"big\", expected f64",
+        );
         let e = fails(&with_line(10, "position = [1.0, 2.0, 3.0]"));
         assert_error(&e, 10, "ball[2].position", "invalid length 3");
         let e = fails(&with_line(37, "grid = [2, -3]"));
@@ -862,7 +884,9 @@ grid = [2, 3]
     fn sector_errors() {
         let e = fails(&with_line(37, "grid = [0, 3]"));
         assert_error(&e, 37, "sectors.grid", "at least one sector");
-        let e = fails(&format!("{BASE}[[sectors.polygon]]\npoints = [[0, 0], [1, 1]]\n"));
+        let e = fails(&format!(
+            "{BASE}[[sectors.polygon]]\npoints = [[0, 0], [1, 1]]\n"
+        ));
         assert_error(&e, 37, "sectors", "not both");
         let e = fails(&with_line(37, "# no grid"));
         assert_error(&e, 36, "sectors", "needs grid");
