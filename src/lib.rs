@@ -5,7 +5,9 @@
 //! - [`geometry`] and [`physics`]: pure functions of trajectories (thesis ch. 3);
 //! - [`scenario`]: tables and balls from TOML or built-in generators, validated once;
 //! - [`vtime`]: the lexicographic virtual time that orders simultaneous events exactly;
-//! - [`engine`]: the event-list and time-step engines;
+//! - [`kernel`]: a generic message-passing kernel (objects, batches, cancellation, statistics);
+//! - [`model`]: the pool objects and PHOLD as kernel models;
+//! - [`engine`]: the event-list, time-step and objects engines;
 //! - [`check`]: invariants checked while a run goes (`--check`);
 //! - [`output`]: the trace, final state and run summary.
 
@@ -13,6 +15,8 @@ pub mod bench;
 pub mod check;
 pub mod engine;
 pub mod geometry;
+pub mod kernel;
+pub mod model;
 pub mod output;
 pub mod physics;
 pub mod run;

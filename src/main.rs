@@ -5,6 +5,7 @@
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use poolsim::engine::{Event, Observer, RunError, World};
+use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};
 use poolsim::run::{execute, EngineKind, RunConfig};
 use poolsim::scenario::{self, builtin, Scenario};
@@ -60,7 +61,7 @@ impl GenArgs {
 struct RunArgs {
     /// A built-in scenario name (see `poolsim scenarios`) or a TOML file.
     scenario: String,
-    /// event-list, time-step (objects and time-warp come with their issues).
+    /// event-list, time-step or objects (time-warp comes with its issue).
     #[arg(long, default_value = "event-list")]
     engine: String,
     /// Sector layout: none, auto, N or NxM (sectored engines only).
@@ -177,7 +178,47 @@ fn load(spec: &str, gen: &GenArgs) -> Result<Scenario, Failure> {
     scenario::load(spec, &gen.params()).map_err(|e| usage(e.to_string()))
 }
 
-fn engine_of(a: &RunArgs) -> Result<EngineKind, Failure> {
+/// `--newvelocity-delay`: absent or 0 is exact; `auto` is the thesis' choice (4.4): a ball at the
+/// fastest initial speed moves 1% of the smallest diameter in the delay.
+fn nv_delay(arg: Option<&str>, s: &Scenario) -> Result<NvDelay, Failure> {
+    let d = match arg {
+        None => return Ok(NvDelay::Exact),
+        Some("auto") => {
+            let vmax = s
+                .balls
+                .iter()
+                .map(|b| b.velocity.norm())
+                .fold(0.0, f64::max);
+            let dmin = s
+                .balls
+                .iter()
+                .map(|b| 2.0 * b.radius)
+                .fold(f64::INFINITY, f64::min);
+            if vmax > 0.0 && dmin.is_finite() {
+                0.01 * dmin / vmax
+            } else {
+                0.0
+            }
+        }
+        Some(text) => text.parse::<f64>().map_err(|_| {
+            usage(format!(
+                "--newvelocity-delay: expected a number or `auto`, got `{text}`"
+            ))
+        })?,
+    };
+    if !d.is_finite() || d < 0.0 {
+        return Err(usage(format!(
+            "--newvelocity-delay: must be a finite number not below 0, got {d}"
+        )));
+    }
+    Ok(if d == 0.0 {
+        NvDelay::Exact
+    } else {
+        NvDelay::Delay(d)
+    })
+}
+
+fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
     match a.engine.as_str() {
         "event-list" => {
             if let Some(flag) = a.dt.map(|_| "--dt") {
@@ -193,30 +234,43 @@ fn engine_of(a: &RunArgs) -> Result<EngineKind, Failure> {
             }
             Ok(EngineKind::TimeStep { dt })
         }
-        "objects" | "time-warp" => Err(usage(format!(
-            "--engine: `{}` is not built yet; available: event-list, time-step",
-            a.engine
-        ))),
+        "objects" => {
+            if let Some(s) = a.sectors.as_deref().filter(|s| *s != "none") {
+                return Err(usage(format!(
+                    "--sectors: `{s}` is not built yet; the objects engine runs with --sectors none"
+                )));
+            }
+            Ok(EngineKind::Objects {
+                delay: nv_delay(a.newvelocity_delay.as_deref(), scenario)?,
+            })
+        }
+        "time-warp" => Err(usage(
+            "--engine: `time-warp` is not built yet; available: event-list, time-step, objects",
+        )),
         other => Err(usage(format!(
-            "--engine: unknown engine `{other}`; available: event-list, time-step"
+            "--engine: unknown engine `{other}`; available: event-list, time-step, objects"
         ))),
     }
 }
 
 fn run(a: &RunArgs) -> Result<(), Failure> {
-    let engine = engine_of(a)?;
+    let scenario = load(&a.scenario, &a.gen)?;
+    let engine = engine_of(a, &scenario)?;
+    let objects = matches!(engine, EngineKind::Objects { .. });
     for (flag, given) in [
-        ("--sectors", a.sectors.is_some()),
+        ("--sectors", a.sectors.is_some() && !objects),
+        (
+            "--newvelocity-delay",
+            a.newvelocity_delay.is_some() && !objects,
+        ),
         ("--workers", a.workers.is_some()),
-        ("--newvelocity-delay", a.newvelocity_delay.is_some()),
     ] {
         if given {
             return Err(usage(format!(
-                "{flag}: only the objects and time-warp engines take it, and they are not built yet"
+                "{flag}: only the objects and time-warp engines take it"
             )));
         }
     }
-    let scenario = load(&a.scenario, &a.gen)?;
     let until = a.until.unwrap_or(scenario.until);
     if !until.is_finite() || until < 0.0 {
         return Err(usage(format!(

@@ -40,7 +40,9 @@ fn reference(s: &Scenario) -> (Vec<TraceLine>, Vec<BallState>) {
                     Contact::Never => {}
                     Contact::At(t) => offer(Key::at(t, pair(i, j)), i, j),
                     Contact::Immediate => {
-                        let parent = fixed_at[i as usize].clone().max(fixed_at[j as usize].clone());
+                        let parent = fixed_at[i as usize]
+                            .clone()
+                            .max(fixed_at[j as usize].clone());
                         offer(parent.child(pair(i, j)), i, j)
                     }
                 }
@@ -126,11 +128,15 @@ fn random_scenario() -> impl Strategy<Value = Scenario> {
                 let position = if !balls.is_empty() && rng.gen_bool(0.3) {
                     // touching an earlier ball, along an exact direction
                     let other: &BallSpec = &balls[rng.gen_range(0..balls.len())];
-                    let (dx, dy) = [(1.0, 0.0), (0.0, 1.0), (0.6, 0.8), (-0.8, 0.6)][rng.gen_range(0..4)];
+                    let (dx, dy) =
+                        [(1.0, 0.0), (0.0, 1.0), (0.6, 0.8), (-0.8, 0.6)][rng.gen_range(0..4)];
                     let d = other.radius + radius;
                     other.position + Vec2::new(dx * d, dy * d)
                 } else {
-                    Vec2::new(rng.gen_range(radius..w - radius), rng.gen_range(radius..h - radius))
+                    Vec2::new(
+                        rng.gen_range(radius..w - radius),
+                        rng.gen_range(radius..h - radius),
+                    )
                 };
                 let inside = position.x >= radius
                     && position.x <= w - radius

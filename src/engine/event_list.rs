@@ -438,6 +438,7 @@ impl EventList {
                 ("cell_crossings", self.stats.cell_crossings as f64),
                 ("max_cascade_depth", self.stats.max_depth as f64),
             ],
+            messages: Vec::new(),
         })
     }
 

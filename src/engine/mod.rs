@@ -8,6 +8,7 @@
 pub mod calendar;
 pub mod event_list;
 pub mod grid;
+pub mod objects;
 pub mod time_step;
 
 use crate::geometry::{Trajectory, Vec2};
@@ -380,4 +381,6 @@ pub struct Outcome {
     pub events: EventCounts,
     /// Engine-specific counters, by name, for the run summary.
     pub engine_stats: Vec<(&'static str, f64)>,
+    /// Messages sent, by thesis type (empty for engines that send none).
+    pub messages: Vec<(&'static str, u64)>,
 }

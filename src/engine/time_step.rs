@@ -268,6 +268,7 @@ impl TimeStep {
                     s.overlapping_separating as f64,
                 ),
             ],
+            messages: Vec::new(),
         })
     }
 }

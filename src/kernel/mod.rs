@@ -1,0 +1,261 @@
+//! A generic message-passing discrete-event kernel (thesis 2.3): it knows nothing of pool.
+//!
+//! ```text
+//!            send / send_now / send_at                 batch of one key
+//!  object ─────────────────────────────► pending set ────────────────────► object.handle()
+//!     ▲          cancel(handle) retracts ─┘   (ordered by VTime, receiver,          │
+//!     └──────────────────────────────────────  priority, sender, sequence)  ◄───────┘
+//! ```
+//!
+//! A model is a set of objects, each with a state and a behaviour. An object touches nothing but
+//! its own state and the messages it is given; every effect on the rest of the simulation is a
+//! message. The kernel runs an object once per virtual time at which it has messages, with all of
+//! them as one batch ordered by message priority (thesis 4.3.1), then sender, then the sender's
+//! send sequence: never by address or hash order.
+//!
+//! Virtual time ([`VTime`]) is a [`Key`] and a generation: a message sent with zero delay while
+//! handling `(k, g)` arrives at `(k, g + 1)`, after the batch that sent it and before every other
+//! key of the instant; a message sent to an explicit key (a predicted collision) arrives there
+//! with generation 0. No message may go into the receiver's past.
+//!
+//! States are `Clone` and kept small so an optimistic executor can save and restore them; each
+//! object's send counter (which names its messages) lives beside its state for the same reason.
+
+pub mod sequential;
+
+use crate::vtime::Key;
+use std::cmp::Ordering;
+use std::fmt::Debug;
+
+/// Virtual time: a key and the generation of zero-delay sends within it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VTime {
+    /// The key (time and pair path).
+    pub key: Key,
+    /// How many zero-delay hops after `key` this is.
+    pub gen: u32,
+}
+
+impl VTime {
+    /// The time of an explicit key, generation 0.
+    pub fn at(key: Key) -> VTime {
+        VTime { key, gen: 0 }
+    }
+
+    /// The time a zero-delay message sent now arrives.
+    pub fn next_gen(&self) -> VTime {
+        VTime {
+            key: self.key.clone(),
+            gen: self.gen + 1,
+        }
+    }
+
+    /// Simulation time.
+    pub fn t(&self) -> f64 {
+        self.key.t
+    }
+}
+
+impl Eq for VTime {}
+
+impl PartialOrd for VTime {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for VTime {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.key
+            .cmp(&other.key)
+            .then_with(|| self.gen.cmp(&other.gen))
+    }
+}
+
+/// Names a sent message so that its sender can cancel it: the sender and its send sequence.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Handle {
+    /// The sending object.
+    pub from: u32,
+    /// The sender's sequence number of the send.
+    pub seq: u64,
+}
+
+/// A message as delivered: its payload, its sender and its name.
+#[derive(Clone, Debug)]
+pub struct Envelope<M> {
+    /// The sending object.
+    pub from: u32,
+    /// The sender's send sequence number.
+    pub seq: u64,
+    /// The payload.
+    pub msg: M,
+}
+
+/// A simulation model for the kernel: message and state types and the objects' behaviour.
+pub trait Model {
+    /// Message payloads.
+    type Msg: Clone + Debug;
+    /// One object's state.
+    type State: Clone;
+    /// What objects report as they go (physical events, drawings): committed output.
+    type Output;
+
+    /// Names of the message types, indexed by [`Model::kind`], for the statistics.
+    fn kind_names(&self) -> &'static [&'static str];
+    /// The type index of a message.
+    fn kind(&self, msg: &Self::Msg) -> usize;
+    /// Priority inside a batch: lower runs first.
+    fn priority(&self, msg: &Self::Msg) -> u8;
+    /// Sets object `me` up at the start time; it may send messages.
+    fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, state: &mut Self::State);
+    /// Runs object `me` over one batch of messages, all with the virtual time `ctx.now()`.
+    fn handle(
+        &self,
+        ctx: &mut Ctx<'_, Self>,
+        me: u32,
+        state: &mut Self::State,
+        batch: &[Envelope<Self::Msg>],
+    );
+}
+
+/// A message waiting to be delivered.
+#[derive(Clone, Debug)]
+pub struct Pending<M> {
+    /// When it arrives.
+    pub time: VTime,
+    /// The receiving object.
+    pub to: u32,
+    /// Its priority in the receiver's batch.
+    pub priority: u8,
+    /// Sender, sequence and payload.
+    pub env: Envelope<M>,
+}
+
+impl<M> Pending<M> {
+    /// The delivery order: time, receiver, priority, sender, sequence.
+    pub fn order(&self, o: &Self) -> Ordering {
+        self.time
+            .cmp(&o.time)
+            .then(self.to.cmp(&o.to))
+            .then(self.priority.cmp(&o.priority))
+            .then(self.env.from.cmp(&o.env.from))
+            .then(self.env.seq.cmp(&o.env.seq))
+    }
+
+    /// This message's handle.
+    pub fn handle(&self) -> Handle {
+        Handle {
+            from: self.env.from,
+            seq: self.env.seq,
+        }
+    }
+}
+
+/// What one batch did, handed back to the executor: messages sent, sends retracted, output.
+pub struct Ctx<'a, M: Model + ?Sized> {
+    model: &'a M,
+    now: VTime,
+    me: u32,
+    seq: &'a mut u64,
+    /// Messages sent by this batch.
+    pub sent: Vec<Pending<M::Msg>>,
+    /// Handles this batch cancelled.
+    pub cancelled: Vec<Handle>,
+    /// Output this batch produced.
+    pub output: Vec<M::Output>,
+}
+
+impl<'a, M: Model + ?Sized> Ctx<'a, M> {
+    /// A context for object `me` at `now`, with its send counter.
+    pub fn new(model: &'a M, now: VTime, me: u32, seq: &'a mut u64) -> Ctx<'a, M> {
+        Ctx {
+            model,
+            now,
+            me,
+            seq,
+            sent: Vec::new(),
+            cancelled: Vec::new(),
+            output: Vec::new(),
+        }
+    }
+
+    /// The virtual time of the batch being handled.
+    pub fn now(&self) -> &VTime {
+        &self.now
+    }
+
+    /// Sends `msg` to `to` at virtual time `time`, which must not be before now.
+    ///
+    /// # Panics
+    /// If `time` is before now: a model bug, a message into the past.
+    pub fn send_at(&mut self, to: u32, time: VTime, msg: M::Msg) -> Handle {
+        assert!(
+            time > self.now,
+            "object {} sent a message into the past: {:?} at {:?}",
+            self.me,
+            time,
+            self.now
+        );
+        *self.seq += 1;
+        let env = Envelope {
+            from: self.me,
+            seq: *self.seq,
+            msg,
+        };
+        let p = Pending {
+            time,
+            to,
+            priority: self.model.priority(&env.msg),
+            env,
+        };
+        let h = p.handle();
+        self.sent.push(p);
+        h
+    }
+
+    /// Sends `msg` to `to` with zero delay: it arrives after this batch, within the same key.
+    pub fn send_now(&mut self, to: u32, msg: M::Msg) -> Handle {
+        let time = self.now.next_gen();
+        self.send_at(to, time, msg)
+    }
+
+    /// Retracts a message this object sent (one thesis Cancel message). Cancelling a message
+    /// that was already delivered is a model bug the executor reports.
+    pub fn cancel(&mut self, h: Handle) {
+        self.cancelled.push(h);
+    }
+
+    /// Reports output (a physical event, a drawing).
+    pub fn emit(&mut self, out: M::Output) {
+        self.output.push(out);
+    }
+}
+
+/// Message counts by type, as sent, and cancellations.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct MessageStats {
+    /// Sent messages by type index.
+    pub sent: Vec<u64>,
+    /// Messages retracted by `cancel` (each one thesis Cancel message).
+    pub cancels: u64,
+    /// Batches run (object activations).
+    pub batches: u64,
+    /// Messages delivered.
+    pub delivered: u64,
+}
+
+impl MessageStats {
+    /// Counts a sent message of type `kind`.
+    pub fn count(&mut self, kind: usize) {
+        if self.sent.len() <= kind {
+            self.sent.resize(kind + 1, 0);
+        }
+        self.sent[kind] += 1;
+    }
+
+    /// The count of type `kind`.
+    pub fn get(&self, kind: usize) -> u64 {
+        self.sent.get(kind).copied().unwrap_or(0)
+    }
+}

@@ -1,0 +1,154 @@
+//! The sequential executor: one pending set, batches run strictly in order.
+
+use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime};
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashSet};
+
+/// A pending message ordered for a min-heap.
+struct Item<M>(Pending<M>);
+
+impl<M> PartialEq for Item<M> {
+    fn eq(&self, o: &Self) -> bool {
+        self.0.order(&o.0) == Ordering::Equal
+    }
+}
+
+impl<M> Eq for Item<M> {}
+
+impl<M> PartialOrd for Item<M> {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl<M> Ord for Item<M> {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.order(&self.0)
+    }
+}
+
+/// Runs a model's objects one batch at a time in virtual-time order.
+pub struct Sequential<M: Model> {
+    model: M,
+    states: Vec<M::State>,
+    seqs: Vec<u64>,
+    pending: BinaryHeap<Item<M::Msg>>,
+    cancelled: HashSet<Handle>,
+    stats: MessageStats,
+    now: Option<VTime>,
+}
+
+impl<M: Model> Sequential<M> {
+    /// Sets up the model's objects with their initial states and runs every object's `init` at
+    /// virtual time `start` (in object order).
+    pub fn new(model: M, states: Vec<M::State>, start: VTime) -> Sequential<M> {
+        let mut s = Sequential {
+            seqs: vec![0; states.len()],
+            model,
+            states,
+            pending: BinaryHeap::new(),
+            cancelled: HashSet::new(),
+            stats: MessageStats::default(),
+            now: None,
+        };
+        for me in 0..s.states.len() as u32 {
+            let mut ctx = Ctx::new(&s.model, start.clone(), me, &mut s.seqs[me as usize]);
+            s.model.init(&mut ctx, me, &mut s.states[me as usize]);
+            let (sent, cancelled) = (ctx.sent, ctx.cancelled);
+            assert!(cancelled.is_empty(), "init may not cancel");
+            for p in sent {
+                s.stats.count(s.model.kind(&p.env.msg));
+                s.pending.push(Item(p));
+            }
+        }
+        s
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// Every object's state.
+    pub fn states(&self) -> &[M::State] {
+        &self.states
+    }
+
+    /// Message statistics so far.
+    pub fn stats(&self) -> &MessageStats {
+        &self.stats
+    }
+
+    /// The virtual time of the last batch run.
+    pub fn now(&self) -> Option<&VTime> {
+        self.now.as_ref()
+    }
+
+    /// Messages waiting (cancelled ones not yet discarded included).
+    pub fn pending_len(&self) -> usize {
+        self.pending.len()
+    }
+
+    /// Pops the next message that was not cancelled.
+    fn pop_live(&mut self) -> Option<Pending<M::Msg>> {
+        while let Some(Item(p)) = self.pending.pop() {
+            if !self.cancelled.remove(&p.handle()) {
+                return Some(p);
+            }
+        }
+        None
+    }
+
+    /// Runs every batch with time at most `until`, passing each output, with the states after
+    /// the batch that produced it, to `sink`; stops at the first error the sink returns.
+    pub fn run<E>(
+        &mut self,
+        until: f64,
+        sink: &mut dyn FnMut(&M, &[M::State], M::Output) -> Result<(), E>,
+    ) -> Result<(), E> {
+        loop {
+            match self.pending.peek() {
+                Some(Item(p)) if p.time.t() <= until => {}
+                _ => return Ok(()),
+            }
+            let Some(first) = self.pop_live() else {
+                return Ok(());
+            };
+            if first.time.t() > until {
+                self.pending.push(Item(first));
+                return Ok(());
+            }
+            let (time, to) = (first.time, first.to);
+            let mut batch: Vec<Envelope<M::Msg>> = vec![first.env];
+            while let Some(Item(p)) = self.pending.peek() {
+                if p.to != to || p.time != time {
+                    break;
+                }
+                let Some(p) = self.pop_live() else { break };
+                if p.to != to || p.time != time {
+                    self.pending.push(Item(p));
+                    break;
+                }
+                batch.push(p.env);
+            }
+            self.stats.batches += 1;
+            self.stats.delivered += batch.len() as u64;
+            let mut ctx = Ctx::new(&self.model, time.clone(), to, &mut self.seqs[to as usize]);
+            self.model
+                .handle(&mut ctx, to, &mut self.states[to as usize], &batch);
+            let (sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
+            for h in cancelled {
+                self.stats.cancels += 1;
+                self.cancelled.insert(h);
+            }
+            for p in sent {
+                self.stats.count(self.model.kind(&p.env.msg));
+                self.pending.push(Item(p));
+            }
+            self.now = Some(time);
+            for o in output {
+                sink(&self.model, &self.states, o)?;
+            }
+        }
+    }
+}

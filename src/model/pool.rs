@@ -1,0 +1,465 @@
+//! The pool objects of thesis fig. 3 as kernel objects: balls, cushions, pockets and corners.
+//!
+//! ```text
+//!                 NewVelocity (to every other object; at start only to higher-numbered balls)
+//!   Ball ─────────────────────────────────────────────────────────► Ball / Cushion / Pocket / Corner
+//!    ▲                                                                     │
+//!    │            Collision (to the ball, and to itself)                   │
+//!    └─────────────────────────────────────────────────────────────────────┘
+//!                 Cancel (the kernel retracts both Collision messages)
+//! ```
+//!
+//! When a ball changes velocity it cancels the collisions it scheduled and tells every other
+//! object its new trajectory. The receiver cancels what it had scheduled with that ball and, if
+//! they will meet, schedules the collision by sending a Collision message to the ball and one to
+//! itself (thesis 2.3). Exactly one object schedules each pair: a fixed object always; of two
+//! balls, the receiver of the NewVelocity, except that when both changed at the same key (they
+//! just collided) only the higher-numbered one does (it is the one told by a lower-numbered ball,
+//! as at start, 4.1).
+//!
+//! Exact mode (`delay = 0`): NewVelocity goes out with zero delay, so it arrives within the same
+//! key, and a collision's key is a pure function of the two trajectories and the keys they were
+//! fixed at, exactly as in the event-list engine. The physical events are then the event-list
+//! engine's, in the same order, bit for bit.
+//!
+//! Thesis mode (`delay = d > 0`, 4.4): NewVelocity arrives `d` later; a collision found in the past
+//! is made immediate if the balls still overlap and close (5.3). Each ball computes its new
+//! velocity from the partner's trajectory carried in the Collision message, as the thesis does, so
+//! this mode shows the thesis' errors: lost updates in simultaneous collisions (table 2), balls
+//! compressed into each other, and tunneling above `(r1 + r2) / d`.
+
+use crate::engine::{Event, EventKind, Fixed, Table};
+use crate::geometry::Trajectory;
+use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
+use crate::physics::{self, Contact};
+use crate::scenario::Scenario;
+use crate::vtime::{pair, Key};
+use std::sync::Arc;
+
+/// What a ball tells others about itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BallInfo {
+    /// Trajectory since its last velocity change.
+    pub traj: Trajectory,
+    /// Radius.
+    pub radius: f64,
+    /// Mass.
+    pub mass: f64,
+    /// The key of the event that fixed the trajectory.
+    pub fixed: Key,
+    /// The pocket it dropped into.
+    pub pocket: Option<u32>,
+}
+
+/// Messages of the pool simulation.
+#[derive(Clone, Debug)]
+pub enum PoolMsg {
+    /// A ball's new trajectory (thesis NewVelocity).
+    NewVelocity(Arc<BallInfo>),
+    /// A scheduled collision of the receiver with `partner`; for a ball partner, the partner's
+    /// trajectory as the scheduler knew it.
+    Collision {
+        /// The other object of the collision.
+        partner: u32,
+        /// The partner ball's state when the collision was scheduled.
+        info: Option<Arc<BallInfo>>,
+    },
+}
+
+/// Type indices of the messages, for the statistics.
+pub const NEW_VELOCITY: usize = 0;
+/// See [`NEW_VELOCITY`].
+pub const COLLISION: usize = 1;
+
+/// One collision an object scheduled: the partner and the two Collision messages.
+#[derive(Clone, Debug)]
+pub struct Planned {
+    /// The other object of the collision (the one that is not the scheduler).
+    pub partner: u32,
+    /// The Collision message to the scheduler itself.
+    pub own: Handle,
+    /// The Collision message to the partner.
+    pub other: Handle,
+}
+
+/// A pool object's state.
+#[derive(Clone, Debug)]
+pub enum PoolState {
+    /// A ball and the collisions it scheduled.
+    Ball {
+        /// Its trajectory and properties.
+        info: Arc<BallInfo>,
+        /// Collisions it scheduled.
+        planned: Vec<Planned>,
+    },
+    /// A cushion, pocket or corner and the collisions it scheduled.
+    Fixed {
+        /// Collisions it scheduled.
+        planned: Vec<Planned>,
+        /// Balls it holds (pockets only), in the order they dropped in.
+        holds: Vec<u32>,
+    },
+}
+
+/// How NewVelocity messages travel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NvDelay {
+    /// Zero delay: exact (the default).
+    Exact,
+    /// The thesis' small positive delay (4.4).
+    Delay(f64),
+}
+
+/// The pool model: the table (static configuration) and the NewVelocity delay.
+pub struct Pool {
+    table: Table,
+    delay: NvDelay,
+}
+
+impl Pool {
+    /// The model and the initial states of every object of a validated scenario.
+    pub fn new(s: &Scenario, delay: NvDelay) -> (Pool, Vec<PoolState>) {
+        let table = Table::new(s);
+        let mut states: Vec<PoolState> = s
+            .balls
+            .iter()
+            .map(|b| PoolState::Ball {
+                info: Arc::new(BallInfo {
+                    traj: Trajectory {
+                        position: b.position,
+                        velocity: b.velocity,
+                        t0: 0.0,
+                    },
+                    radius: b.radius,
+                    mass: b.mass,
+                    fixed: Key::start(0.0),
+                    pocket: None,
+                }),
+                planned: Vec::new(),
+            })
+            .collect();
+        for _ in 0..table.n_fixed() {
+            states.push(PoolState::Fixed {
+                planned: Vec::new(),
+                holds: Vec::new(),
+            });
+        }
+        (Pool { table, delay }, states)
+    }
+
+    /// The table.
+    pub fn table(&self) -> &Table {
+        &self.table
+    }
+
+    /// The number of objects.
+    pub fn n_objects(&self) -> u32 {
+        self.table.n_balls + self.table.n_fixed()
+    }
+
+    /// The virtual time at which a NewVelocity sent now to `to` arrives.
+    fn nv_time(&self, ctx: &Ctx<'_, Pool>, me: u32, to: u32) -> VTime {
+        match self.delay {
+            NvDelay::Exact => ctx.now().next_gen(),
+            NvDelay::Delay(d) => VTime::at(Key::at(ctx.now().t() + d, pair(me, to))),
+        }
+    }
+
+    /// Sends ball `me`'s new trajectory to `targets`.
+    fn broadcast(
+        &self,
+        ctx: &mut Ctx<'_, Pool>,
+        me: u32,
+        info: &Arc<BallInfo>,
+        targets: impl Iterator<Item = u32>,
+    ) {
+        for to in targets {
+            let time = self.nv_time(ctx, me, to);
+            ctx.send_at(to, time, PoolMsg::NewVelocity(info.clone()));
+        }
+    }
+
+    /// The key of a contact found now, or `None`. In thesis mode a contact already in the past
+    /// becomes immediate if the objects still overlap and close (5.3).
+    fn contact_key(
+        &self,
+        now: &VTime,
+        contact: Contact,
+        parent: &Key,
+        p: crate::vtime::Pair,
+        still_closing: impl Fn() -> bool,
+    ) -> Option<Key> {
+        match (contact, self.delay) {
+            (Contact::Never, _) => None,
+            (Contact::At(t), NvDelay::Exact) => Some(Key::at(t, p)),
+            (Contact::Immediate, NvDelay::Exact) => Some(parent.child(p)),
+            (Contact::At(t), NvDelay::Delay(_)) if t > now.t() => Some(Key::at(t, p)),
+            (_, NvDelay::Delay(_)) => still_closing().then(|| now.key.child(p)),
+        }
+    }
+
+    /// Schedules the collision of `me` and `partner` at `key`: a Collision message to each.
+    fn schedule(
+        ctx: &mut Ctx<'_, Pool>,
+        me: u32,
+        partner: u32,
+        key: Key,
+        mine: Option<Arc<BallInfo>>,
+        theirs: Option<Arc<BallInfo>>,
+    ) -> Planned {
+        let time = VTime::at(key);
+        let own = ctx.send_at(
+            me,
+            time.clone(),
+            PoolMsg::Collision {
+                partner,
+                info: theirs,
+            },
+        );
+        let other = ctx.send_at(
+            partner,
+            time,
+            PoolMsg::Collision {
+                partner: me,
+                info: mine,
+            },
+        );
+        Planned {
+            partner,
+            own,
+            other,
+        }
+    }
+
+    /// Cancels what `planned` holds with `partner`, if anything.
+    fn cancel_with(ctx: &mut Ctx<'_, Pool>, planned: &mut Vec<Planned>, partner: u32) {
+        if let Some(k) = planned.iter().position(|p| p.partner == partner) {
+            let p = planned.swap_remove(k);
+            ctx.cancel(p.own);
+            ctx.cancel(p.other);
+        }
+    }
+
+    fn ball_batch(
+        &self,
+        ctx: &mut Ctx<'_, Pool>,
+        me: u32,
+        info: &mut Arc<BallInfo>,
+        planned: &mut Vec<Planned>,
+        batch: &[Envelope<PoolMsg>],
+    ) {
+        let mut changed = false;
+        for env in batch {
+            match &env.msg {
+                PoolMsg::Collision {
+                    partner,
+                    info: other,
+                } => {
+                    if info.pocket.is_some() {
+                        continue;
+                    }
+                    // the collision happens: if this ball scheduled it, it is no longer planned
+                    if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
+                        planned.swap_remove(k);
+                    }
+                    let now = ctx.now().clone();
+                    let t = now.t();
+                    let me_info = Arc::make_mut(info);
+                    let p = me_info.traj.at(t);
+                    let mut kind = None;
+                    if let Some(o) = other {
+                        let q = o.traj.at(t);
+                        let (v, _) = if me < *partner {
+                            let (a, b) = physics::ball_ball_velocities(
+                                p,
+                                me_info.traj.velocity,
+                                me_info.mass,
+                                q,
+                                o.traj.velocity,
+                                o.mass,
+                            );
+                            (a, b)
+                        } else {
+                            let (a, b) = physics::ball_ball_velocities(
+                                q,
+                                o.traj.velocity,
+                                o.mass,
+                                p,
+                                me_info.traj.velocity,
+                                me_info.mass,
+                            );
+                            (b, a)
+                        };
+                        me_info.traj.velocity = v;
+                        if me > *partner {
+                            kind = Some((EventKind::BallBall, *partner, me));
+                        }
+                    } else {
+                        match self.table.bounce(*partner, p, me_info.traj.velocity) {
+                            Some(v) => me_info.traj.velocity = v,
+                            None => {
+                                let Fixed::Pocket(k) = self.table.fixed(*partner) else {
+                                    unreachable!("only pockets swallow balls")
+                                };
+                                me_info.pocket = Some(k);
+                            }
+                        }
+                        kind = Some((self.table.event_kind(*partner), me, *partner));
+                    }
+                    me_info.traj.position = p;
+                    me_info.traj.t0 = t;
+                    me_info.fixed = now.key.clone();
+                    changed = true;
+                    if let Some((kind, a, b)) = kind {
+                        ctx.emit(Event { t, kind, a, b });
+                    }
+                }
+                PoolMsg::NewVelocity(x) => {
+                    let from = env.from;
+                    Self::cancel_with(ctx, planned, from);
+                    if info.pocket.is_some() || x.pocket.is_some() {
+                        continue;
+                    }
+                    // both changed at one key: the higher-numbered ball schedules the pair
+                    if x.fixed == info.fixed && from > me {
+                        continue;
+                    }
+                    let (lo, hi) = if me < from {
+                        (&**info, &**x)
+                    } else {
+                        (&**x, &**info)
+                    };
+                    let contact =
+                        physics::ball_ball_contact(&lo.traj, lo.radius, &hi.traj, hi.radius);
+                    let now = ctx.now().clone();
+                    let parent = if info.fixed > x.fixed {
+                        &info.fixed
+                    } else {
+                        &x.fixed
+                    };
+                    let closing = || overlapping_and_closing(lo, hi, now.t());
+                    if let Some(key) =
+                        self.contact_key(&now, contact, parent, pair(me, from), closing)
+                    {
+                        let p =
+                            Self::schedule(ctx, me, from, key, Some(info.clone()), Some(x.clone()));
+                        planned.push(p);
+                    }
+                }
+            }
+        }
+        if changed {
+            for p in planned.drain(..) {
+                ctx.cancel(p.own);
+                ctx.cancel(p.other);
+            }
+            let n = self.n_objects();
+            self.broadcast(ctx, me, info, (0..n).filter(|&o| o != me));
+        }
+    }
+
+    fn fixed_batch(
+        &self,
+        ctx: &mut Ctx<'_, Pool>,
+        me: u32,
+        planned: &mut Vec<Planned>,
+        holds: &mut Vec<u32>,
+        batch: &[Envelope<PoolMsg>],
+    ) {
+        for env in batch {
+            match &env.msg {
+                PoolMsg::Collision { partner, .. } => {
+                    if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
+                        planned.swap_remove(k);
+                    }
+                    if let Fixed::Pocket(_) = self.table.fixed(me) {
+                        holds.push(*partner);
+                    }
+                }
+                PoolMsg::NewVelocity(x) => {
+                    let from = env.from;
+                    Self::cancel_with(ctx, planned, from);
+                    if x.pocket.is_some() {
+                        continue;
+                    }
+                    let contact = self.table.contact(me, &x.traj, x.radius);
+                    let now = ctx.now().clone();
+                    let closing = || self.fixed_overlapping_and_closing(me, x, now.t());
+                    if let Some(key) =
+                        self.contact_key(&now, contact, &x.fixed, pair(from, me), closing)
+                    {
+                        let p = Self::schedule(ctx, me, from, key, None, None);
+                        planned.push(p);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Thesis mode: whether a ball overlapping fixed object `f` at `t` still moves into it.
+    fn fixed_overlapping_and_closing(&self, f: u32, x: &BallInfo, t: f64) -> bool {
+        let now = Trajectory {
+            position: x.traj.at(t),
+            velocity: x.traj.velocity,
+            t0: t,
+        };
+        self.table.contact(f, &now, x.radius) == Contact::Immediate
+    }
+}
+
+/// Thesis mode: whether two balls overlap at `t` and are still closing (thesis 5.3).
+fn overlapping_and_closing(a: &BallInfo, b: &BallInfo, t: f64) -> bool {
+    let at = |x: &BallInfo| Trajectory {
+        position: x.traj.at(t),
+        velocity: x.traj.velocity,
+        t0: t,
+    };
+    physics::ball_ball_contact(&at(a), a.radius, &at(b), b.radius) == Contact::Immediate
+}
+
+impl Model for Pool {
+    type Msg = PoolMsg;
+    type State = PoolState;
+    type Output = Event;
+
+    fn kind_names(&self) -> &'static [&'static str] {
+        &["NewVelocity", "Collision"]
+    }
+
+    fn kind(&self, msg: &PoolMsg) -> usize {
+        match msg {
+            PoolMsg::NewVelocity(_) => NEW_VELOCITY,
+            PoolMsg::Collision { .. } => COLLISION,
+        }
+    }
+
+    /// Thesis 4.3.1: Collision before NewVelocity.
+    fn priority(&self, msg: &PoolMsg) -> u8 {
+        match msg {
+            PoolMsg::Collision { .. } => 0,
+            PoolMsg::NewVelocity(_) => 1,
+        }
+    }
+
+    /// Thesis 4.1: each ball tells the higher-numbered balls and every fixed object its initial
+    /// trajectory, so every pair is scheduled once.
+    fn init(&self, ctx: &mut Ctx<'_, Pool>, me: u32, state: &mut PoolState) {
+        if let PoolState::Ball { info, .. } = state {
+            let n = self.n_objects();
+            self.broadcast(ctx, me, info, me + 1..n);
+        }
+    }
+
+    fn handle(
+        &self,
+        ctx: &mut Ctx<'_, Pool>,
+        me: u32,
+        state: &mut PoolState,
+        batch: &[Envelope<PoolMsg>],
+    ) {
+        match state {
+            PoolState::Ball { info, planned } => self.ball_batch(ctx, me, info, planned, batch),
+            PoolState::Fixed { planned, holds } => self.fixed_batch(ctx, me, planned, holds, batch),
+        }
+    }
+}
