@@ -4,6 +4,10 @@ use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime};
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashSet};
 
+/// Receives each output with the model and the states just after the batch that produced it.
+pub type Sink<'a, M, E> =
+    dyn FnMut(&M, &[<M as Model>::State], <M as Model>::Output) -> Result<(), E> + 'a;
+
 /// A pending message ordered for a min-heap.
 struct Item<M>(Pending<M>);
 
@@ -104,7 +108,7 @@ impl<M: Model> Sequential<M> {
     pub fn run<E>(
         &mut self,
         until: f64,
-        sink: &mut dyn FnMut(&M, &[M::State], M::Output) -> Result<(), E>,
+        sink: &mut Sink<'_, M, E>,
     ) -> Result<(), E> {
         loop {
             match self.pending.peek() {
