@@ -105,11 +105,7 @@ impl<M: Model> Sequential<M> {
 
     /// Runs every batch with time at most `until`, passing each output, with the states after
     /// the batch that produced it, to `sink`; stops at the first error the sink returns.
-    pub fn run<E>(
-        &mut self,
-        until: f64,
-        sink: &mut Sink<'_, M, E>,
-    ) -> Result<(), E> {
+    pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), E> {
         loop {
             match self.pending.peek() {
                 Some(Item(p)) if p.time.t() <= until => {}
