@@ -1,5 +1,6 @@
 //! `poolsim bench`: physical events per second and nanoseconds per event of the event-list engine
-//! on the thesis gas, over ball counts and area fractions, with the machine's description.
+//! on the thesis gas, over ball counts and area fractions, with the machine's description; then
+//! the objects engine's cost over ball counts, and PHOLD's committed events per second.
 //!
 //! Setup (generating the gas and predicting every ball's first event) is timed apart from the
 //! event loop, so the figures are the steady cost of an event. Each configuration runs a fixed
@@ -31,6 +32,16 @@ pub struct BenchArgs {
     /// Physical events measured per configuration (at least 5 per ball are run).
     #[arg(long, default_value_t = 2_000_000)]
     pub events: u64,
+    /// Ball counts for the objects engine (non-sectored: its cost per event grows with N).
+    #[arg(
+        long = "objects-balls",
+        value_delimiter = ',',
+        default_value = "36,144,576"
+    )]
+    pub objects_balls: Vec<usize>,
+    /// PHOLD objects (16 messages each, remote 0.1, 2 partitions, lookahead 0.1).
+    #[arg(long = "phold-objects", default_value_t = 1024)]
+    pub phold_objects: u32,
     /// Grid cell width in ball diameters.
     #[arg(long = "cell-diameters", default_value_t = 1.0)]
     pub cell_diameters: f64,
@@ -167,11 +178,94 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             rows.push(r);
         }
     }
+    if !a.json {
+        println!();
+        println!("objects engine (thesis fig. 3, sequential, non-sectored), thesis gas until 4");
+        println!(
+            "{:>9} {:>11} {:>12} {:>9} {:>14} {:>12} {:>10}",
+            "balls", "events", "messages", "wall s", "events/s", "messages/s", "msgs/event"
+        );
+    }
+    let mut objects = Vec::new();
+    for &n in &a.objects_balls {
+        let r = measure_objects(n)?;
+        if !a.json {
+            println!(
+                "{:>9} {:>11} {:>12} {:>9.3} {:>14.0} {:>12.0} {:>10.1}",
+                r.balls,
+                r.events,
+                r.messages,
+                r.seconds,
+                r.events as f64 / r.seconds,
+                r.messages as f64 / r.seconds,
+                r.messages as f64 / r.events.max(1) as f64
+            );
+        }
+        objects.push(r);
+    }
+    let phold = crate::model::phold::run_sequential(
+        crate::model::phold::PholdConfig {
+            objects: a.phold_objects,
+            events_per_object: 16,
+            remote: 0.1,
+            partitions: 2,
+            lookahead: 0.1,
+            mean: 1.0,
+            seed: 1,
+        },
+        20.0,
+    );
     if a.json {
         println!(
             "{}",
-            json!({"machine": m, "engine": "event-list", "rows": rows})
+            json!({"machine": m, "engine": "event-list", "rows": rows,
+                   "objects": objects, "phold": phold})
+        );
+    } else {
+        println!();
+        println!(
+            "PHOLD, sequential kernel: {} objects x 16 events, remote 0.1, end 20: {} committed, \
+             {:.0} events/s",
+            phold.objects, phold.committed, phold.events_per_second
         );
     }
     Ok(())
+}
+
+/// One measured run of the objects engine.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ObjectsRow {
+    /// Balls.
+    pub balls: usize,
+    /// Physical events.
+    pub events: u64,
+    /// Messages sent (the thesis' total: NewVelocity, Collision, Cancel).
+    pub messages: u64,
+    /// Wall seconds, setup included.
+    pub seconds: f64,
+}
+
+/// Runs the thesis gas (seed 1, until 4) on the objects engine.
+pub fn measure_objects(balls: usize) -> Result<ObjectsRow, String> {
+    let k = ((balls as f64).sqrt().round() as usize).max(1);
+    let params = Params {
+        balls: Some(k * k),
+        seed: Some(1),
+        ..Params::default()
+    };
+    let scenario =
+        builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
+    let start = Instant::now();
+    let mut engine =
+        crate::engine::objects::Objects::new(&scenario, crate::model::pool::NvDelay::Exact);
+    let out = engine
+        .run(scenario.until, &mut Ignore)
+        .map_err(|e| e.to_string())?;
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(ObjectsRow {
+        balls: k * k,
+        events: out.events.total(),
+        messages: out.messages.iter().map(|(_, c)| c).sum(),
+        seconds,
+    })
 }

@@ -112,6 +112,103 @@ enum Command {
     },
     /// Measure events per second over ball counts and densities.
     Bench(poolsim::bench::BenchArgs),
+    /// Run PHOLD, the standard PDES benchmark, and report committed events per second.
+    Phold(PholdArgs),
+}
+
+/// Arguments of `poolsim phold`.
+#[derive(clap::Args, Clone, Debug)]
+struct PholdArgs {
+    /// Number of objects.
+    #[arg(long, default_value_t = 1024)]
+    objects: u32,
+    /// Messages each object starts with.
+    #[arg(long = "events-per-object", default_value_t = 16)]
+    events_per_object: u32,
+    /// Probability that a message goes to another partition.
+    #[arg(long, default_value_t = 0.1)]
+    remote: f64,
+    /// Partitions (workers of a parallel run); objects are split in equal blocks.
+    #[arg(long, default_value_t = 2)]
+    partitions: u32,
+    /// End time.
+    #[arg(long, default_value_t = 100.0)]
+    end: f64,
+    /// Minimum delay of a message.
+    #[arg(long, default_value_t = 0.1)]
+    lookahead: f64,
+    /// Mean of the exponential part of the delay.
+    #[arg(long, default_value_t = 1.0)]
+    mean: f64,
+    /// Seed of the objects' random streams.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+fn phold(a: &PholdArgs) -> Result<(), Failure> {
+    use poolsim::model::phold::{run_sequential, PholdConfig};
+    let positive = |flag: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(usage(format!("{flag}: must be a positive number, got {v}")))
+        }
+    };
+    positive("--end", a.end)?;
+    positive("--mean", a.mean)?;
+    if !(a.lookahead.is_finite() && a.lookahead >= 0.0) {
+        return Err(usage(format!(
+            "--lookahead: must not be negative, got {}",
+            a.lookahead
+        )));
+    }
+    if !(0.0..=1.0).contains(&a.remote) {
+        return Err(usage(format!(
+            "--remote: must lie in [0, 1], got {}",
+            a.remote
+        )));
+    }
+    if a.objects == 0 || a.partitions == 0 || a.partitions > a.objects {
+        return Err(usage(format!(
+            "--objects and --partitions: need 1 <= partitions <= objects, got {} and {}",
+            a.partitions, a.objects
+        )));
+    }
+    let report = run_sequential(
+        PholdConfig {
+            objects: a.objects,
+            events_per_object: a.events_per_object,
+            remote: a.remote,
+            partitions: a.partitions,
+            lookahead: a.lookahead,
+            mean: a.mean,
+            seed: a.seed,
+        },
+        a.end,
+    );
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&report).expect("a report serializes")
+        );
+    } else {
+        println!(
+            "PHOLD {} objects x {} events, remote {}, {} partitions, end {}: {} committed events \
+             in {:.3} s, {:.0} events/s",
+            report.objects,
+            report.events_per_object,
+            report.remote,
+            report.partitions,
+            report.end,
+            report.committed,
+            report.wall_seconds,
+            report.events_per_second
+        );
+    }
+    Ok(())
 }
 
 /// A failure with its exit status.
@@ -405,6 +502,7 @@ fn main() -> ExitCode {
         Command::Run(a) => run(a),
         Command::Demo { json } => demo(*json),
         Command::Bench(b) => poolsim::bench::run(b).map_err(usage),
+        Command::Phold(a) => phold(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,1 +1,255 @@
-//! PHOLD.
+//! PHOLD, the standard synthetic benchmark of parallel discrete-event simulators (Fujimoto 1990;
+//! ROSS's `models/phold`), as a kernel model.
+//!
+//! ```text
+//!   object i ──(one message per event, after lookahead + Exp(mean))──► object j
+//!            j in another partition with probability `remote`, else in i's own
+//! ```
+//!
+//! Each of `objects` objects starts with `events_per_object` messages to itself. Handling a
+//! message sends exactly one new one, so the message population stays constant. Every object
+//! draws from its own seeded random stream, kept in its state, so a run is the same whatever
+//! executes it.
+
+use crate::kernel::{Ctx, Envelope, Model, VTime};
+use crate::vtime::Key;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// PHOLD's parameters.
+#[derive(Clone, Debug)]
+pub struct PholdConfig {
+    /// Number of objects.
+    pub objects: u32,
+    /// Messages each object starts with.
+    pub events_per_object: u32,
+    /// Probability that a message goes to another partition.
+    pub remote: f64,
+    /// Number of partitions (the workers of a parallel run), objects split in equal blocks.
+    pub partitions: u32,
+    /// Minimum delay of every message.
+    pub lookahead: f64,
+    /// Mean of the exponential part of the delay.
+    pub mean: f64,
+    /// Seed of every object's random stream.
+    pub seed: u64,
+}
+
+/// One PHOLD object: its random stream and its counts.
+#[derive(Clone, Debug)]
+pub struct PholdState {
+    rng: ChaCha8Rng,
+    sends: u64,
+    /// Messages handled.
+    pub handled: u64,
+}
+
+/// The PHOLD model.
+pub struct Phold {
+    cfg: PholdConfig,
+}
+
+impl Phold {
+    /// The model and every object's initial state.
+    pub fn new(cfg: PholdConfig) -> (Phold, Vec<PholdState>) {
+        let states = (0..cfg.objects)
+            .map(|i| PholdState {
+                rng: ChaCha8Rng::seed_from_u64(
+                    cfg.seed ^ (u64::from(i) << 20).wrapping_mul(0x9e37_79b9),
+                ),
+                sends: 0,
+                handled: 0,
+            })
+            .collect();
+        (Phold { cfg }, states)
+    }
+
+    /// The partition of object `i`.
+    pub fn partition(&self, i: u32) -> u32 {
+        (u64::from(i) * u64::from(self.cfg.partitions) / u64::from(self.cfg.objects)) as u32
+    }
+
+    /// The objects of partition `p`: a contiguous block.
+    fn block(&self, p: u32) -> (u32, u32) {
+        let n = u64::from(self.cfg.objects);
+        let k = u64::from(self.cfg.partitions);
+        let lo = (u64::from(p) * n).div_ceil(k) as u32;
+        let hi = ((u64::from(p) + 1) * n).div_ceil(k) as u32;
+        (lo, hi)
+    }
+
+    /// Draws the receiver and delay of one message from object `me`.
+    fn draw(&self, me: u32, rng: &mut ChaCha8Rng) -> (u32, f64) {
+        let own = self.partition(me);
+        let p = if self.cfg.partitions > 1 && rng.gen_bool(self.cfg.remote.clamp(0.0, 1.0)) {
+            let other = rng.gen_range(0..self.cfg.partitions - 1);
+            if other >= own {
+                other + 1
+            } else {
+                other
+            }
+        } else {
+            own
+        };
+        let (lo, hi) = self.block(p);
+        let to = rng.gen_range(lo..hi.max(lo + 1));
+        let u: f64 = rng.gen_range(f64::EPSILON..1.0);
+        (to, self.cfg.lookahead - self.cfg.mean * u.ln())
+    }
+
+    fn send(&self, ctx: &mut Ctx<'_, Phold>, me: u32, state: &mut PholdState) {
+        let (to, delay) = self.draw(me, &mut state.rng);
+        state.sends += 1;
+        // ties between messages at one time are broken by sender and the sender's count
+        let tie = (u64::from(me) << 32) | (state.sends & 0xffff_ffff);
+        let t = ctx.now().t() + delay;
+        ctx.send_at(to, VTime::at(Key::at(t, tie)), ());
+    }
+}
+
+impl Model for Phold {
+    type Msg = ();
+    type State = PholdState;
+    type Output = ();
+
+    fn kind_names(&self) -> &'static [&'static str] {
+        &["Event"]
+    }
+
+    fn kind(&self, _: &()) -> usize {
+        0
+    }
+
+    fn priority(&self, _: &()) -> u8 {
+        0
+    }
+
+    fn init(&self, ctx: &mut Ctx<'_, Phold>, me: u32, state: &mut PholdState) {
+        for _ in 0..self.cfg.events_per_object {
+            self.send(ctx, me, state);
+        }
+    }
+
+    fn handle(
+        &self,
+        ctx: &mut Ctx<'_, Phold>,
+        me: u32,
+        state: &mut PholdState,
+        batch: &[Envelope<()>],
+    ) {
+        for _ in batch {
+            state.handled += 1;
+            self.send(ctx, me, state);
+        }
+    }
+}
+
+/// What a PHOLD run did.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PholdReport {
+    /// Objects.
+    pub objects: u32,
+    /// Messages each object started with.
+    pub events_per_object: u32,
+    /// Remote probability.
+    pub remote: f64,
+    /// Partitions.
+    pub partitions: u32,
+    /// End time.
+    pub end: f64,
+    /// Executor: `objects` (sequential).
+    pub engine: &'static str,
+    /// Events (messages handled) committed.
+    pub committed: u64,
+    /// Seconds spent running (setup included).
+    pub wall_seconds: f64,
+    /// Committed events per second.
+    pub events_per_second: f64,
+}
+
+/// Runs PHOLD on the sequential executor up to time `end`.
+pub fn run_sequential(cfg: PholdConfig, end: f64) -> PholdReport {
+    use crate::kernel::sequential::Sequential;
+    let start = std::time::Instant::now();
+    let report = PholdReport {
+        objects: cfg.objects,
+        events_per_object: cfg.events_per_object,
+        remote: cfg.remote,
+        partitions: cfg.partitions,
+        end,
+        engine: "objects",
+        committed: 0,
+        wall_seconds: 0.0,
+        events_per_second: 0.0,
+    };
+    let (model, states) = Phold::new(cfg);
+    let mut ex = Sequential::new(model, states, VTime::at(Key::start(0.0)));
+    let never: Result<(), std::convert::Infallible> = ex.run(end, &mut |_, _, _| Ok(()));
+    let Ok(()) = never;
+    let wall = start.elapsed().as_secs_f64();
+    let committed = ex.stats().delivered;
+    PholdReport {
+        committed,
+        wall_seconds: wall,
+        events_per_second: committed as f64 / wall.max(1e-9),
+        ..report
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::sequential::Sequential;
+
+    fn cfg(partitions: u32, remote: f64) -> PholdConfig {
+        PholdConfig {
+            objects: 64,
+            events_per_object: 4,
+            remote,
+            partitions,
+            lookahead: 0.1,
+            mean: 1.0,
+            seed: 5,
+        }
+    }
+
+    fn run(c: PholdConfig, end: f64) -> (u64, Vec<u64>, usize) {
+        let (model, states) = Phold::new(c);
+        let mut ex = Sequential::new(model, states, VTime::at(Key::start(0.0)));
+        ex.run::<()>(end, &mut |_, _, _| Ok(())).unwrap();
+        let handled: Vec<u64> = ex.states().iter().map(|s| s.handled).collect();
+        (ex.stats().delivered, handled, ex.pending_len())
+    }
+
+    #[test]
+    fn population_is_constant_and_runs_repeat() {
+        let (delivered, handled, pending) = run(cfg(4, 0.5), 20.0);
+        assert_eq!(pending, 64 * 4, "one message sent per message handled");
+        assert_eq!(delivered, handled.iter().sum::<u64>());
+        // about objects * events / mean-delay * end events
+        assert!(
+            delivered > 64 * 4 * 10 && delivered < 64 * 4 * 25,
+            "{delivered}"
+        );
+        assert_eq!(run(cfg(4, 0.5), 20.0).1, handled);
+    }
+
+    #[test]
+    fn remote_fraction_is_respected() {
+        let (model, _) = Phold::new(cfg(4, 0.25));
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        let n = 20_000;
+        let remote = (0..n)
+            .filter(|_| {
+                let (to, d) = model.draw(3, &mut rng);
+                assert!(d >= 0.1);
+                model.partition(to) != model.partition(3)
+            })
+            .count();
+        let frac = remote as f64 / f64::from(n);
+        assert!((frac - 0.25).abs() < 0.02, "{frac}");
+        // one partition: nothing is remote
+        let (model, _) = Phold::new(cfg(1, 0.9));
+        assert!((0..1000).all(|_| model.partition(model.draw(3, &mut rng).0) == 0));
+    }
+}
