@@ -120,7 +120,11 @@ pub fn measure(
     };
     let scenario =
         builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
-    let mut engine = EventList::new(&scenario, Options { cell_diameters });
+    let opts = Options {
+        cell_diameters,
+        ..Options::default()
+    };
+    let mut engine = EventList::new(&scenario, opts);
     let setup = start.elapsed().as_secs_f64();
     let target = events.max(5 * (k * k) as u64);
     let start = Instant::now();
@@ -256,8 +260,11 @@ pub fn measure_objects(balls: usize) -> Result<ObjectsRow, String> {
     let scenario =
         builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
     let start = Instant::now();
-    let mut engine =
-        crate::engine::objects::Objects::new(&scenario, crate::model::pool::NvDelay::Exact);
+    let mut engine = crate::engine::objects::Objects::new(
+        &scenario,
+        crate::model::pool::NvDelay::Exact,
+        Default::default(),
+    );
     let out = engine
         .run(scenario.until, &mut Ignore)
         .map_err(|e| e.to_string())?;

@@ -11,6 +11,7 @@
 //! - [`check`]: invariants checked while a run goes (`--check`);
 //! - [`output`]: the trace, final state and run summary.
 
+pub mod analytic;
 pub mod bench;
 pub mod check;
 pub mod engine;
@@ -19,6 +20,7 @@ pub mod kernel;
 pub mod model;
 pub mod output;
 pub mod physics;
+pub mod polygon;
 pub mod run;
 pub mod scenario;
 pub mod vtime;

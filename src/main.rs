@@ -378,6 +378,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         engine,
         until,
         check: a.check,
+        span: Default::default(),
     };
     let mut trace = match &a.trace {
         Some(p) => Some(TraceWriter::new(BufWriter::new(File::create(p).map_err(
@@ -483,6 +484,7 @@ fn demo(json: bool) -> Result<(), Failure> {
         engine: EngineKind::EventList,
         until: scenario.until,
         check: true,
+        span: Default::default(),
     };
     let report = execute(&scenario, &cfg, &mut poolsim::engine::Ignore)
         .map_err(|e| internal(e.to_string()))?;

@@ -7,7 +7,7 @@ use crate::check::Checker;
 use crate::engine::event_list::{self, EventList};
 use crate::engine::objects::Objects;
 use crate::engine::time_step::{self, TimeStep};
-use crate::engine::{BallState, Event, Observer, Outcome, RunError, Table, World};
+use crate::engine::{BallState, Event, Observer, Outcome, RunError, Span, Table, World};
 use crate::model::pool::NvDelay;
 use crate::output::{digest, events_json};
 use crate::physics::kinetic_energy;
@@ -52,6 +52,8 @@ pub struct RunConfig {
     pub until: f64,
     /// Check invariants at every event.
     pub check: bool,
+    /// Start time and reversal.
+    pub span: Span,
 }
 
 /// What a run produced.
@@ -104,7 +106,7 @@ pub fn execute(
     obs: &mut dyn Observer,
 ) -> Result<Report, RunError> {
     let start = Instant::now();
-    let initial = BallState::initial(scenario);
+    let initial = BallState::initial(scenario, cfg.span.start);
     let table = Table::new(scenario);
     let checker = cfg
         .check
@@ -112,7 +114,11 @@ pub fn execute(
     let mut sinks = Sinks { checker, user: obs };
     let outcome = match cfg.engine {
         EngineKind::EventList => {
-            let mut e = EventList::new(scenario, event_list::Options::default());
+            let opts = event_list::Options {
+                span: cfg.span,
+                ..Default::default()
+            };
+            let mut e = EventList::new(scenario, opts);
             let out = e.run(cfg.until, &mut sinks)?;
             if let Some(c) = &mut sinks.checker {
                 c.sweep(&e, cfg.until.min(out.t))?;
@@ -120,11 +126,11 @@ pub fn execute(
             out
         }
         EngineKind::TimeStep { dt } => {
-            let mut e = TimeStep::new(scenario, time_step::Options { dt });
+            let mut e = TimeStep::new(scenario, time_step::Options { dt, span: cfg.span });
             e.run(cfg.until, &mut sinks)?
         }
         EngineKind::Objects { delay } => {
-            let mut e = Objects::new(scenario, delay);
+            let mut e = Objects::new(scenario, delay, cfg.span);
             e.run(cfg.until, &mut sinks)?
         }
     };

@@ -20,6 +20,14 @@ use std::cmp::Ordering;
 /// `(lower, higher)` tuples.
 pub type Pair = u64;
 
+/// The pair code of a reversal of every ball (thesis 4.6): it runs after every physical event of
+/// its instant.
+pub const REVERSAL: Pair = u64::MAX - 2;
+
+/// The pair code of a frame of the display (thesis 4.2): after the reversal, if any, so that a
+/// frame shows the state after everything at its time.
+pub const DISPLAY: Pair = u64::MAX - 1;
+
 /// Packs the pair of objects `a` and `b` (in either order) in canonical order.
 #[inline]
 pub fn pair(a: u32, b: u32) -> Pair {

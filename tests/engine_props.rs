@@ -18,7 +18,7 @@ use common::random_scenario;
 /// The simplest correct event-driven simulation: after every event, test every pair.
 fn reference(s: &Scenario) -> (Vec<TraceLine>, Vec<BallState>) {
     let table = Table::new(s);
-    let mut balls = BallState::initial(s);
+    let mut balls = BallState::initial(s, 0.0);
     let mut fixed_at = vec![Key::start(0.0); balls.len()];
     let n = balls.len() as u32;
     let mut trace = Vec::new();
@@ -116,6 +116,7 @@ fn engine_run(s: &Scenario, check: bool) -> (Vec<TraceLine>, Vec<BallState>) {
         engine: EngineKind::EventList,
         until: s.until,
         check,
+        span: Default::default(),
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.outcome.balls)
@@ -141,7 +142,7 @@ proptest! {
     fn wide_cells_change_nothing(s in random_scenario()) {
         prop_assume!(s.validate().is_ok());
         let mut a = EventList::new(&s, Options::default());
-        let mut b = EventList::new(&s, Options { cell_diameters: 3.5 });
+        let mut b = EventList::new(&s, Options { cell_diameters: 3.5, ..Options::default() });
         let (mut ra, mut rb) = (TraceRecorder::default(), TraceRecorder::default());
         let oa = a.run(s.until, &mut ra).unwrap();
         let ob = b.run(s.until, &mut rb).unwrap();

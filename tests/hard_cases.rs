@@ -20,6 +20,7 @@ fn run(s: &Scenario) -> (Vec<TraceLine>, Vec<BallState>) {
         engine: EngineKind::EventList,
         until: s.until,
         check: true,
+        span: Default::default(),
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.outcome.balls)

@@ -16,6 +16,7 @@ fn run(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>, serde_
         engine,
         until: s.until,
         check,
+        span: Default::default(),
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.summary)
@@ -105,6 +106,7 @@ fn delay_mode_loses_an_update_as_in_table_2() {
         engine: delayed,
         until: s.until,
         check: false,
+        span: Default::default(),
     };
     let report = execute(&s, &cfg, &mut poolsim::engine::Ignore).unwrap();
     let v: Vec<f64> = report

@@ -18,11 +18,14 @@
 
 use super::calendar::Calendar;
 use super::grid::Grid;
-use super::{BallState, Event, EventCounts, EventKind, Observer, Outcome, RunError, Table, World};
+use super::{
+    BallState, Event, EventCounts, EventKind, Fixed, Observer, Outcome, RunError, Span, Table,
+    World,
+};
 use crate::geometry::Trajectory;
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
-use crate::vtime::{pair, Key, Pair};
+use crate::vtime::{pair, Key, Pair, REVERSAL};
 use std::cmp::Ordering;
 
 /// The pair code that marks a ball leaving its cell: sorts after every physical event of its
@@ -57,6 +60,8 @@ enum Partner {
     Ball(u32, u32),
     /// A fixed object (global index).
     Fixed(u32),
+    /// The ball comes back out of the pocket (global index) it dropped into, after a reversal.
+    Return(u32),
 }
 
 /// The hot part of a ball's state, one cache line: what a neighbour's prediction reads.
@@ -107,6 +112,8 @@ pub struct EventList {
     queue: Calendar,
     grid: Grid,
     now: f64,
+    /// The key of the reversal still to come, if any.
+    reversal: Option<Key>,
     stats: Stats,
 }
 
@@ -115,12 +122,15 @@ pub struct EventList {
 pub struct Options {
     /// Minimum grid cell width in ball diameters (at least 1).
     pub cell_diameters: f64,
+    /// Start time and reversal.
+    pub span: Span,
 }
 
 impl Default for Options {
     fn default() -> Options {
         Options {
             cell_diameters: 1.0,
+            span: Span::default(),
         }
     }
 }
@@ -129,7 +139,8 @@ impl EventList {
     /// Sets up the engine at time 0 for a validated scenario and predicts every ball's first event.
     pub fn new(s: &Scenario, opts: Options) -> EventList {
         let table = Table::new(s);
-        let balls = BallState::initial(s);
+        let start = opts.span.start;
+        let balls = BallState::initial(s, start);
         let n = balls.len();
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
         let mut grid = Grid::new(&table, n, rmax, 2.0 * rmax * opts.cell_diameters.max(1.0));
@@ -153,13 +164,14 @@ impl EventList {
             slots,
             mass: balls.iter().map(|b| b.mass).collect(),
             pocket: vec![None; n],
-            fixed_at: vec![Key::start(0.0); n],
+            fixed_at: vec![Key::start(start); n],
             phys: vec![Best::none(); n],
             cross_cell: vec![0; n],
             keys: vec![Key::at(f64::INFINITY, 0); n],
-            queue: Calendar::new(n, 0.0, 1.0),
+            queue: Calendar::new(n, start, 1.0),
             grid,
-            now: 0.0,
+            now: start,
+            reversal: opts.span.reverse_at.map(|t| Key::at(t, REVERSAL)),
             stats: Stats::default(),
         };
         // First predictions go into a provisional calendar; the real one's bucket width comes
@@ -173,8 +185,8 @@ impl EventList {
             .map(|k| k.t)
             .filter(|t| t.is_finite())
             .collect();
-        let mean = finite.iter().sum::<f64>() / finite.len().max(1) as f64;
-        e.queue = Calendar::new(n, 0.0, mean / finite.len().max(1) as f64);
+        let mean = finite.iter().map(|t| t - start).sum::<f64>() / finite.len().max(1) as f64;
+        e.queue = Calendar::new(n, start, mean / finite.len().max(1) as f64);
         for i in 0..n as u32 {
             e.queue.set(&e.keys, i);
         }
@@ -358,7 +370,16 @@ impl EventList {
                 until = self.now;
                 break;
             }
-            let Some(i) = self.queue.first(&self.keys) else {
+            let first = self.queue.first(&self.keys);
+            if let Some(r) = &self.reversal {
+                let before = first.is_none_or(|i| *r < self.keys[i as usize]);
+                if before && r.t <= until {
+                    let r = self.reversal.take().expect("checked above");
+                    self.reverse(&r);
+                    continue;
+                }
+            }
+            let Some(i) = first else {
                 break;
             };
             let key = self.keys[i as usize].clone();
@@ -373,6 +394,17 @@ impl EventList {
             }
             match self.phys[i as usize].partner {
                 Partner::Nothing => break,
+                Partner::Return(f) => {
+                    let b = &mut self.slots[i as usize];
+                    let cell = self.grid.cell_at(b.traj.position);
+                    b.cell = cell;
+                    b.counter = b.counter.wrapping_add(1);
+                    self.grid.insert(i, cell);
+                    self.pocket[i as usize] = None;
+                    self.fixed_at[i as usize] = key.clone();
+                    self.predict(i);
+                    self.emit(&key, EventKind::BallPocket, i, f, &mut counts, obs)?;
+                }
                 Partner::Ball(j, seen) if self.slots[j as usize].counter != seen => {
                     self.stats.stale += 1;
                     self.predict(i);
@@ -402,7 +434,7 @@ impl EventList {
                         Some(v) => self.set_velocity(i, &key, v),
                         None => {
                             self.set_velocity(i, &key, b.traj.velocity);
-                            let super::Fixed::Pocket(k) = self.table.fixed(f) else {
+                            let Fixed::Pocket(k) = self.table.fixed(f) else {
                                 unreachable!("only pockets swallow balls")
                             };
                             self.pocket[i as usize] = Some(k);
@@ -440,6 +472,47 @@ impl EventList {
             ],
             messages: Vec::new(),
         })
+    }
+
+    /// Turns every ball around at the reversal key `r` (thesis 4.6): balls on the table reverse
+    /// their velocity where they are; a ball in a pocket is set to come back out at the mirror
+    /// image of the time it dropped in, with its entry velocity reversed.
+    fn reverse(&mut self, r: &Key) {
+        self.now = r.t;
+        let n = self.slots.len() as u32;
+        for i in 0..n {
+            let b = &mut self.slots[i as usize];
+            match self.pocket[i as usize] {
+                None => {
+                    b.traj = Trajectory {
+                        position: b.traj.at(r.t),
+                        velocity: -b.traj.velocity,
+                        t0: r.t,
+                    };
+                    b.counter = b.counter.wrapping_add(1);
+                    self.fixed_at[i as usize] = r.clone();
+                }
+                Some(k) => {
+                    let back = 2.0 * r.t - b.traj.t0;
+                    b.traj = Trajectory {
+                        position: b.traj.position,
+                        velocity: -b.traj.velocity,
+                        t0: back,
+                    };
+                    let f = self.table.fixed_id(Fixed::Pocket(k));
+                    self.phys[i as usize] = Best {
+                        key: crate::model::pool::return_key(r, back, pair(i, f)),
+                        partner: Partner::Return(f),
+                    };
+                    self.requeue(i);
+                }
+            }
+        }
+        for i in 0..n {
+            if self.pocket[i as usize].is_none() {
+                self.predict(i);
+            }
+        }
     }
 
     fn emit(

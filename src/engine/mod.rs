@@ -233,16 +233,26 @@ pub struct BallState {
     pub pocket: Option<u32>,
 }
 
+/// When a run starts, and whether every ball is turned around on the way (thesis 4.6).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Span {
+    /// The time of the scenario's initial positions and velocities.
+    pub start: f64,
+    /// The time at which every ball reverses its velocity, after every event of that instant;
+    /// a ball in a pocket then comes back out at the mirror image of the time it dropped in.
+    pub reverse_at: Option<f64>,
+}
+
 impl BallState {
-    /// The initial states of a scenario's balls, fixed at time 0.
-    pub fn initial(s: &Scenario) -> Vec<BallState> {
+    /// The initial states of a scenario's balls, fixed at time `start`.
+    pub fn initial(s: &Scenario, start: f64) -> Vec<BallState> {
         s.balls
             .iter()
             .map(|b| BallState {
                 traj: Trajectory {
                     position: b.position,
                     velocity: b.velocity,
-                    t0: 0.0,
+                    t0: start,
                 },
                 radius: b.radius,
                 mass: b.mass,

@@ -2,7 +2,7 @@
 //! sequential kernel executor. With zero NewVelocity delay it executes exactly the event-list
 //! engine's physical events.
 
-use super::{BallState, EventCounts, Observer, Outcome, RunError, Table, World};
+use super::{BallState, EventCounts, Observer, Outcome, RunError, Span, Table, World};
 use crate::kernel::sequential::Sequential;
 use crate::kernel::{MessageStats, Model, VTime};
 use crate::model::pool::{NvDelay, Pool, PoolState};
@@ -49,11 +49,11 @@ impl World for View<'_> {
 }
 
 impl Objects {
-    /// Sets the objects up at time 0 (their `init` sends the first NewVelocity messages).
-    pub fn new(s: &Scenario, delay: NvDelay) -> Objects {
-        let (model, states) = Pool::new(s, delay);
+    /// Sets the objects up at `span.start` (their `init` sends the first NewVelocity messages).
+    pub fn new(s: &Scenario, delay: NvDelay, span: Span) -> Objects {
+        let (model, states) = Pool::new(s, delay, span);
         Objects {
-            exec: Sequential::new(model, states, VTime::at(Key::start(0.0))),
+            exec: Sequential::new(model, states, VTime::at(Key::start(span.start))),
         }
     }
 

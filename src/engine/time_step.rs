@@ -9,7 +9,9 @@
 //! previous step) — beside its cost in steps and pair tests (2.1: `O(n T / Δt)` with a cell grid).
 
 use super::grid::Grid;
-use super::{BallState, Event, EventCounts, EventKind, Observer, Outcome, RunError, Table, World};
+use super::{
+    BallState, Event, EventCounts, EventKind, Observer, Outcome, RunError, Span, Table, World,
+};
 use crate::geometry::{Trajectory, Vec2};
 use crate::physics;
 use crate::scenario::Scenario;
@@ -19,6 +21,8 @@ use crate::scenario::Scenario;
 pub struct Options {
     /// The time step.
     pub dt: f64,
+    /// Start time and reversal (a step ends exactly at the reversal).
+    pub span: Span,
 }
 
 /// What the time-step engine got wrong and what it cost.
@@ -47,14 +51,17 @@ pub struct TimeStep {
     grid: Grid,
     dt: f64,
     t: f64,
+    reverse_at: Option<f64>,
+    /// Balls to come back out of their pocket after the reversal: (time, ball, pocket id).
+    returns: Vec<(f64, u32, u32)>,
     stats: Stats,
 }
 
 impl TimeStep {
-    /// Sets up the engine at time 0 for a validated scenario; `dt` must be positive.
+    /// Sets up the engine at `opts.span.start` for a validated scenario; `dt` must be positive.
     pub fn new(s: &Scenario, opts: Options) -> TimeStep {
         let table = Table::new(s);
-        let balls = BallState::initial(s);
+        let balls = BallState::initial(s, opts.span.start);
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
         let mut grid = Grid::new(&table, balls.len(), rmax, 2.0 * rmax);
         for (i, b) in balls.iter().enumerate() {
@@ -65,7 +72,9 @@ impl TimeStep {
             balls,
             grid,
             dt: opts.dt,
-            t: 0.0,
+            t: opts.span.start,
+            reverse_at: opts.span.reverse_at,
+            returns: Vec::new(),
             stats: Stats::default(),
         }
     }
@@ -104,6 +113,49 @@ impl TimeStep {
             },
             self,
         )
+    }
+
+    /// Turns every ball around now (thesis 4.6); a pocketed ball is set to come back out at the
+    /// mirror image of the time it dropped in.
+    fn reverse(&mut self) {
+        let now = self.t;
+        for (i, b) in self.balls.iter_mut().enumerate() {
+            b.traj.velocity = -b.traj.velocity;
+            if let Some(k) = b.pocket {
+                let f = self.table.fixed_id(super::Fixed::Pocket(k));
+                self.returns.push((2.0 * now - b.traj.t0, i as u32, f));
+            }
+        }
+        self.reverse_at = None;
+    }
+
+    /// Brings back out of their pockets the balls due by now, where they would be by now.
+    fn bring_back(
+        &mut self,
+        counts: &mut EventCounts,
+        obs: &mut dyn Observer,
+    ) -> Result<(), RunError> {
+        let now = self.t;
+        let due: Vec<(f64, u32, u32)> = self
+            .returns
+            .iter()
+            .copied()
+            .filter(|r| r.0 <= now)
+            .collect();
+        self.returns.retain(|r| r.0 > now);
+        for (back, i, f) in due {
+            let b = &mut self.balls[i as usize];
+            b.pocket = None;
+            b.traj = Trajectory {
+                position: b.traj.position + (now - back) * b.traj.velocity,
+                velocity: b.traj.velocity,
+                t0: now,
+            };
+            let c = self.grid.cell_at(b.traj.position);
+            self.grid.insert(i, c);
+            self.emit(EventKind::BallPocket, i, f, counts, obs)?;
+        }
+        Ok(())
     }
 
     /// Contacts of ball `i` with fixed objects at the end of a step.
@@ -180,9 +232,13 @@ impl TimeStep {
         let mut counts = EventCounts::default();
         let n = self.balls.len() as u32;
         while self.t < until {
-            let step = self.dt.min(until - self.t);
+            let stop = match self.reverse_at {
+                Some(r) if r > self.t && r < until => r,
+                _ => until,
+            };
+            let step = self.dt.min(stop - self.t);
             self.t = if step < self.dt {
-                until
+                stop
             } else {
                 self.t + self.dt
             };
@@ -244,6 +300,10 @@ impl TimeStep {
                     self.set_velocity(j, vb);
                     self.emit(EventKind::BallBall, i, j, &mut counts, obs)?;
                 }
+            }
+            self.bring_back(&mut counts, obs)?;
+            if self.reverse_at == Some(self.t) {
+                self.reverse();
             }
         }
         let s = self.stats;

@@ -7,6 +7,9 @@
 //!    │            Collision (to the ball, and to itself)                   │
 //!    └─────────────────────────────────────────────────────────────────────┘
 //!                 Cancel (the kernel retracts both Collision messages)
+//!
+//!   Ball ──ReverseYourself──► itself (at the reversal, 4.6)
+//!   Ball ──ReturnToTable────► itself (a pocketed ball comes back out, fig. 13)
 //! ```
 //!
 //! When a ball changes velocity it cancels the collisions it scheduled and tells every other
@@ -28,12 +31,12 @@
 //! this mode shows the thesis' errors: lost updates in simultaneous collisions (table 2), balls
 //! compressed into each other, and tunneling above `(r1 + r2) / d`.
 
-use crate::engine::{Event, EventKind, Fixed, Table};
+use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::Trajectory;
 use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
-use crate::vtime::{pair, Key};
+use crate::vtime::{pair, Key, REVERSAL};
 use std::sync::Arc;
 
 /// What a ball tells others about itself.
@@ -64,12 +67,20 @@ pub enum PoolMsg {
         /// The partner ball's state when the collision was scheduled.
         info: Option<Arc<BallInfo>>,
     },
+    /// Turn around now (thesis 4.6), sent by each ball to itself at the start.
+    ReverseYourself,
+    /// Come back out of the pocket now (thesis fig. 13), sent by a pocketed ball to itself.
+    ReturnToTable,
 }
 
 /// Type indices of the messages, for the statistics.
 pub const NEW_VELOCITY: usize = 0;
 /// See [`NEW_VELOCITY`].
 pub const COLLISION: usize = 1;
+/// See [`NEW_VELOCITY`].
+pub const REVERSE_YOURSELF: usize = 2;
+/// See [`NEW_VELOCITY`].
+pub const RETURN_TO_TABLE: usize = 3;
 
 /// One collision an object scheduled: the partner and the two Collision messages.
 #[derive(Clone, Debug)]
@@ -110,15 +121,17 @@ pub enum NvDelay {
     Delay(f64),
 }
 
-/// The pool model: the table (static configuration) and the NewVelocity delay.
+/// The pool model: the table (static configuration), the NewVelocity delay and the reversal.
 pub struct Pool {
     table: Table,
     delay: NvDelay,
+    span: Span,
 }
 
 impl Pool {
-    /// The model and the initial states of every object of a validated scenario.
-    pub fn new(s: &Scenario, delay: NvDelay) -> (Pool, Vec<PoolState>) {
+    /// The model and the initial states of every object of a validated scenario, starting at
+    /// `span.start`.
+    pub fn new(s: &Scenario, delay: NvDelay, span: Span) -> (Pool, Vec<PoolState>) {
         let table = Table::new(s);
         let mut states: Vec<PoolState> = s
             .balls
@@ -128,11 +141,11 @@ impl Pool {
                     traj: Trajectory {
                         position: b.position,
                         velocity: b.velocity,
-                        t0: 0.0,
+                        t0: span.start,
                     },
                     radius: b.radius,
                     mass: b.mass,
-                    fixed: Key::start(0.0),
+                    fixed: Key::start(span.start),
                     pocket: None,
                 }),
                 planned: Vec::new(),
@@ -144,7 +157,7 @@ impl Pool {
                 holds: Vec::new(),
             });
         }
-        (Pool { table, delay }, states)
+        (Pool { table, delay, span }, states)
     }
 
     /// The table.
@@ -314,6 +327,41 @@ impl Pool {
                         ctx.emit(Event { t, kind, a, b });
                     }
                 }
+                PoolMsg::ReverseYourself => {
+                    let now = ctx.now().clone();
+                    let me_info = Arc::make_mut(info);
+                    match me_info.pocket {
+                        None => {
+                            me_info.traj.position = me_info.traj.at(now.t());
+                            me_info.traj.t0 = now.t();
+                            me_info.fixed = now.key.clone();
+                            changed = true;
+                        }
+                        Some(k) => {
+                            // out again at the mirror image of the time it dropped in
+                            let back = 2.0 * now.t() - me_info.traj.t0;
+                            me_info.traj.t0 = back;
+                            let f = self.table.fixed_id(Fixed::Pocket(k));
+                            let key = return_key(&now.key, back, pair(me, f));
+                            ctx.send_at(me, VTime::at(key), PoolMsg::ReturnToTable);
+                        }
+                    }
+                    me_info.traj.velocity = -me_info.traj.velocity;
+                }
+                PoolMsg::ReturnToTable => {
+                    let now = ctx.now().clone();
+                    let me_info = Arc::make_mut(info);
+                    let k = me_info.pocket.take().expect("only a pocketed ball returns");
+                    me_info.fixed = now.key.clone();
+                    changed = true;
+                    let f = self.table.fixed_id(Fixed::Pocket(k));
+                    ctx.emit(Event {
+                        t: now.t(),
+                        kind: EventKind::BallPocket,
+                        a: me,
+                        b: f,
+                    });
+                }
                 PoolMsg::NewVelocity(x) => {
                     let from = env.from;
                     Self::cancel_with(ctx, planned, from);
@@ -376,9 +424,15 @@ impl Pool {
                         holds.push(*partner);
                     }
                 }
+                PoolMsg::ReverseYourself | PoolMsg::ReturnToTable => {
+                    unreachable!("only balls are told to reverse or return")
+                }
                 PoolMsg::NewVelocity(x) => {
                     let from = env.from;
                     Self::cancel_with(ctx, planned, from);
+                    if x.pocket.is_none() {
+                        holds.retain(|&b| b != from); // back out after a reversal
+                    }
                     if x.pocket.is_some() {
                         continue;
                     }
@@ -407,6 +461,17 @@ impl Pool {
     }
 }
 
+/// The key at which a ball that dropped into a pocket comes back out at time `back` after the
+/// reversal at `reversal`: an ordinary event key, or a child of the reversal if it dropped in at
+/// the very instant of the reversal.
+pub fn return_key(reversal: &Key, back: f64, p: crate::vtime::Pair) -> Key {
+    if back > reversal.t {
+        Key::at(back, p)
+    } else {
+        reversal.child(p)
+    }
+}
+
 /// Thesis mode: whether two balls overlap at `t` and are still closing (thesis 5.3).
 fn overlapping_and_closing(a: &BallInfo, b: &BallInfo, t: f64) -> bool {
     let at = |x: &BallInfo| Trajectory {
@@ -423,21 +488,30 @@ impl Model for Pool {
     type Output = Event;
 
     fn kind_names(&self) -> &'static [&'static str] {
-        &["NewVelocity", "Collision"]
+        &[
+            "NewVelocity",
+            "Collision",
+            "ReverseYourself",
+            "ReturnToTable",
+        ]
     }
 
     fn kind(&self, msg: &PoolMsg) -> usize {
         match msg {
             PoolMsg::NewVelocity(_) => NEW_VELOCITY,
             PoolMsg::Collision { .. } => COLLISION,
+            PoolMsg::ReverseYourself => REVERSE_YOURSELF,
+            PoolMsg::ReturnToTable => RETURN_TO_TABLE,
         }
     }
 
-    /// Thesis 4.3.1: Collision before NewVelocity.
+    /// Thesis 4.3.1 and 4.6: Collision before NewVelocity, ReverseYourself after all others.
     fn priority(&self, msg: &PoolMsg) -> u8 {
         match msg {
             PoolMsg::Collision { .. } => 0,
-            PoolMsg::NewVelocity(_) => 1,
+            PoolMsg::ReturnToTable => 1,
+            PoolMsg::NewVelocity(_) => 2,
+            PoolMsg::ReverseYourself => 3,
         }
     }
 
@@ -447,6 +521,13 @@ impl Model for Pool {
         if let PoolState::Ball { info, .. } = state {
             let n = self.n_objects();
             self.broadcast(ctx, me, info, me + 1..n);
+            if let Some(t) = self.span.reverse_at {
+                ctx.send_at(
+                    me,
+                    VTime::at(Key::at(t, REVERSAL)),
+                    PoolMsg::ReverseYourself,
+                );
+            }
         }
     }
 
