@@ -114,6 +114,89 @@ enum Command {
     Bench(poolsim::bench::BenchArgs),
     /// Run PHOLD, the standard PDES benchmark, and report committed events per second.
     Phold(PholdArgs),
+    /// Run from -Q to 0, reverse every ball, run on to Q, and report how far the balls end from
+    /// where they started (thesis 4.6-4.7).
+    Reverse(Box<ReverseArgs>),
+}
+
+/// Arguments of `poolsim reverse`.
+#[derive(clap::Args, Clone, Debug)]
+struct ReverseArgs {
+    /// A built-in scenario name or a TOML file; its balls are placed at time -Q.
+    scenario: String,
+    /// Quitting time Q.
+    #[arg(long, allow_negative_numbers = true)]
+    quit: f64,
+    /// event-list, time-step or objects.
+    #[arg(long, default_value = "event-list")]
+    engine: String,
+    #[command(flatten)]
+    gen: GenArgs,
+    /// Time step of the time-step engine.
+    #[arg(long, allow_negative_numbers = true)]
+    dt: Option<f64>,
+    /// Delay of NewVelocity messages (objects engine).
+    #[arg(long = "newvelocity-delay")]
+    newvelocity_delay: Option<String>,
+    /// Check invariants at every event.
+    #[arg(long)]
+    check: bool,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
+    if !(a.quit.is_finite() && a.quit > 0.0) {
+        return Err(usage(format!(
+            "--quit: must be a positive number, got {}",
+            a.quit
+        )));
+    }
+    let scenario = load(&a.scenario, &a.gen)?;
+    let run_args = RunArgs {
+        scenario: a.scenario.clone(),
+        engine: a.engine.clone(),
+        sectors: None,
+        until: None,
+        gen: a.gen.clone(),
+        trace: None,
+        final_state: None,
+        json: a.json,
+        check: a.check,
+        workers: None,
+        newvelocity_delay: a.newvelocity_delay.clone(),
+        dt: a.dt,
+        quiet: true,
+    };
+    let engine = engine_of(&run_args, &scenario)?;
+    let r = poolsim::run::reverse(&scenario, engine, a.quit, a.check)
+        .map_err(|e| internal(e.to_string()))?;
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&r).expect("a report serializes")
+        );
+    } else {
+        println!(
+            "{} on {}: -{} to {}, {} events ({} before the reversal); largest error: position \
+             {:e}, velocity {:e}{}",
+            r.scenario,
+            r.engine,
+            r.quit,
+            r.quit,
+            r.events,
+            r.forward_events,
+            r.max_position_error,
+            r.max_velocity_error,
+            if r.still_pocketed > 0 {
+                format!("; {} balls still in pockets", r.still_pocketed)
+            } else {
+                String::new()
+            }
+        );
+    }
+    Ok(())
 }
 
 /// Arguments of `poolsim phold`.
@@ -505,6 +588,7 @@ fn main() -> ExitCode {
         Command::Demo { json } => demo(*json),
         Command::Bench(b) => poolsim::bench::run(b).map_err(usage),
         Command::Phold(a) => phold(a),
+        Command::Reverse(a) => reverse(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -203,3 +203,80 @@ fn messages_json(sent: &[(&'static str, u64)]) -> Value {
     m.insert("total".into(), total.into());
     Value::Object(m)
 }
+
+/// What a reversal run (thesis 4.6–4.7) found.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ReversalReport {
+    /// The scenario.
+    pub scenario: String,
+    /// The engine.
+    pub engine: &'static str,
+    /// The run went from `-quit` to 0, reversed, and on to `quit`.
+    pub quit: f64,
+    /// Physical events (collisions and pocket crossings) over the whole run.
+    pub events: u64,
+    /// Events in the forward half (before the reversal).
+    pub forward_events: u64,
+    /// The largest distance between a ball's final and initial positions.
+    pub max_position_error: f64,
+    /// The largest difference between a ball's final velocity and its initial one reversed.
+    pub max_velocity_error: f64,
+    /// Balls still in a pocket at the end (they should all have come back).
+    pub still_pocketed: usize,
+    /// Wall-clock seconds.
+    pub wall_seconds: f64,
+}
+
+/// Runs `scenario` from `-quit` to `quit` with every ball reversed at 0, and measures how far the
+/// balls end from where they started (thesis 4.6: time reversibility as a test of accuracy).
+pub fn reverse(
+    scenario: &Scenario,
+    engine: EngineKind,
+    quit: f64,
+    check: bool,
+) -> Result<ReversalReport, RunError> {
+    /// Counts events before the reversal.
+    struct Forward(u64);
+    impl Observer for Forward {
+        fn on_event(&mut self, ev: &Event, _: &dyn World) -> Result<(), RunError> {
+            if ev.t < 0.0 || (ev.t == 0.0 && ev.kind != crate::engine::EventKind::BallPocket) {
+                self.0 += 1;
+            }
+            Ok(())
+        }
+    }
+    let cfg = RunConfig {
+        engine,
+        until: quit,
+        check,
+        span: Span {
+            start: -quit,
+            reverse_at: Some(0.0),
+        },
+    };
+    let mut forward = Forward(0);
+    let report = execute(scenario, &cfg, &mut forward)?;
+    let initial = BallState::initial(scenario, -quit);
+    let mut pos = 0.0f64;
+    let mut vel = 0.0f64;
+    let mut still = 0;
+    for (b, a) in report.outcome.balls.iter().zip(&initial) {
+        if b.pocket.is_some() {
+            still += 1;
+            continue;
+        }
+        pos = pos.max((b.traj.at(quit) - a.traj.position).norm());
+        vel = vel.max((b.traj.velocity + a.traj.velocity).norm());
+    }
+    Ok(ReversalReport {
+        scenario: scenario.name.clone(),
+        engine: engine.name(),
+        quit,
+        events: report.outcome.events.total(),
+        forward_events: forward.0,
+        max_position_error: pos,
+        max_velocity_error: vel,
+        still_pocketed: still,
+        wall_seconds: report.wall_seconds,
+    })
+}
