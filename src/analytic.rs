@@ -413,23 +413,3 @@ mod tests {
         assert!(report(&bad).contains("invalid parameters"));
     }
 }
-#[cfg(test)]
-mod tmp_show {
-    use super::*;
-    #[test]
-    fn show_reports() {
-        print!("{}", report(&ModelParams::new(64.0)));
-        print!(
-            "{}",
-            report(&ModelParams {
-                changes: 64.0,
-                ..ModelParams::new(64.0)
-            })
-        );
-        print!("{}", report(&ModelParams::new(1e6)));
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report_json(&ModelParams::new(4.0))).unwrap()
-        );
-    }
-}

@@ -7,7 +7,7 @@ use crate::check::Checker;
 use crate::engine::event_list::{self, EventList};
 use crate::engine::objects::Objects;
 use crate::engine::time_step::{self, TimeStep};
-use crate::engine::{BallState, Event, Observer, Outcome, RunError, Span, Table, World};
+use crate::engine::{BallState, Event, Frame, Observer, Outcome, RunError, Span, Table, World};
 use crate::model::pool::NvDelay;
 use crate::output::{digest, events_json};
 use crate::physics::kinetic_energy;
@@ -96,6 +96,10 @@ impl Observer for Sinks<'_> {
             c.on_event(ev, world)?;
         }
         self.user.on_event(ev, world)
+    }
+
+    fn on_frame(&mut self, frame: &Frame, table: &Table) -> Result<(), RunError> {
+        self.user.on_frame(frame, table)
     }
 }
 
@@ -252,6 +256,7 @@ pub fn reverse(
         span: Span {
             start: -quit,
             reverse_at: Some(0.0),
+            frame_time: None,
         },
     };
     let mut forward = Forward(0);

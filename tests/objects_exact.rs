@@ -177,3 +177,70 @@ proptest! {
         prop_assert_eq!(&gs["final_state_digest"], &ws["final_state_digest"]);
     }
 }
+
+/// Collects frames.
+#[derive(Default)]
+struct Frames(Vec<poolsim::engine::Frame>);
+
+impl poolsim::engine::Observer for Frames {
+    fn on_event(
+        &mut self,
+        _: &poolsim::engine::Event,
+        _: &dyn poolsim::engine::World,
+    ) -> Result<(), poolsim::engine::RunError> {
+        Ok(())
+    }
+
+    fn on_frame(
+        &mut self,
+        frame: &poolsim::engine::Frame,
+        _: &poolsim::engine::Table,
+    ) -> Result<(), poolsim::engine::RunError> {
+        self.0.push(frame.clone());
+        Ok(())
+    }
+}
+
+/// The Projector's frames (thesis 4.2) are the event-list engine's snapshots, bit for bit, and
+/// each costs one DisplayYourself per object.
+#[test]
+fn projector_frames_match_the_event_list() {
+    for name in ["plate1", "gas", "pool"] {
+        let s = builtin::build(name, &builtin::Params::default()).unwrap();
+        let span = poolsim::engine::Span {
+            frame_time: Some(0.25),
+            ..Default::default()
+        };
+        let mut got = Vec::new();
+        let mut summaries = Vec::new();
+        for engine in [
+            EngineKind::EventList,
+            EngineKind::Objects {
+                delay: NvDelay::Exact,
+            },
+        ] {
+            let cfg = RunConfig {
+                engine,
+                until: s.until,
+                check: true,
+                span,
+            };
+            let mut frames = Frames::default();
+            let report = execute(&s, &cfg, &mut frames).unwrap();
+            got.push(frames.0);
+            summaries.push(report.summary);
+        }
+        let expected = (s.until / 0.25) as usize + 1;
+        assert_eq!(got[0].len(), expected, "{name}");
+        assert_eq!(got[0], got[1], "{name}");
+        let objects = (s.balls.len() + s.cushions.len() + 3 * s.pockets.len()) as u64;
+        assert_eq!(
+            summaries[1]["messages"]["DisplayYourself"]
+                .as_u64()
+                .unwrap(),
+            expected as u64 * (objects + 1) + 1,
+            "{name}: one to each object and one to the Projector itself per frame (and one for \
+             the frame after the end)"
+        );
+    }
+}

@@ -51,6 +51,7 @@ fn a_pocketed_ball_comes_back_out_at_the_mirror_time() {
             span: Span {
                 start: -3.0,
                 reverse_at: Some(0.0),
+                frame_time: None,
             },
         };
         let mut rec = TraceRecorder::default();
@@ -84,6 +85,7 @@ fn forward_and_backward_events_mirror_each_other() {
         span: Span {
             start: -3.0,
             reverse_at: Some(0.0),
+            frame_time: None,
         },
     };
     let mut rec = TraceRecorder::default();

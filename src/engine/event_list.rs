@@ -19,13 +19,13 @@
 use super::calendar::Calendar;
 use super::grid::Grid;
 use super::{
-    BallState, Event, EventCounts, EventKind, Fixed, Observer, Outcome, RunError, Span, Table,
-    World,
+    BallState, Event, EventCounts, EventKind, Fixed, Frame, Observer, Outcome, RunError, Span,
+    Table, World,
 };
 use crate::geometry::Trajectory;
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
-use crate::vtime::{pair, Key, Pair, REVERSAL};
+use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
 use std::cmp::Ordering;
 
 /// The pair code that marks a ball leaving its cell: sorts after every physical event of its
@@ -114,6 +114,10 @@ pub struct EventList {
     now: f64,
     /// The key of the reversal still to come, if any.
     reversal: Option<Key>,
+    /// Start, reversal and frame times.
+    span: Span,
+    /// Frames drawn so far.
+    frames: u64,
     stats: Stats,
 }
 
@@ -172,6 +176,8 @@ impl EventList {
             grid,
             now: start,
             reversal: opts.span.reverse_at.map(|t| Key::at(t, REVERSAL)),
+            span: opts.span,
+            frames: 0,
             stats: Stats::default(),
         };
         // First predictions go into a provisional calendar; the real one's bucket width comes
@@ -376,6 +382,20 @@ impl EventList {
                 if before && r.t <= until {
                     let r = self.reversal.take().expect("checked above");
                     self.reverse(&r);
+                    continue;
+                }
+            }
+            if let Some(f) = self.span.frame(self.frames) {
+                let frame = Key::at(f, DISPLAY);
+                let before = first.is_none_or(|i| frame < self.keys[i as usize])
+                    && self.reversal.as_ref().is_none_or(|r| frame < *r);
+                if before && f <= until {
+                    self.frames += 1;
+                    let frame = Frame {
+                        t: f,
+                        balls: self.state_at(f),
+                    };
+                    obs.on_frame(&frame, &self.table)?;
                     continue;
                 }
             }

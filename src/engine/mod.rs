@@ -233,7 +233,8 @@ pub struct BallState {
     pub pocket: Option<u32>,
 }
 
-/// When a run starts, and whether every ball is turned around on the way (thesis 4.6).
+/// When a run starts, whether every ball is turned around on the way (thesis 4.6), and how often
+/// the display is drawn (4.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Span {
     /// The time of the scenario's initial positions and velocities.
@@ -241,6 +242,16 @@ pub struct Span {
     /// The time at which every ball reverses its velocity, after every event of that instant;
     /// a ball in a pocket then comes back out at the mirror image of the time it dropped in.
     pub reverse_at: Option<f64>,
+    /// Time between frames of the display: frames are drawn at `start`, `start + F`, … (none
+    /// when `None`).
+    pub frame_time: Option<f64>,
+}
+
+impl Span {
+    /// The time of frame `k`.
+    pub fn frame(&self, k: u64) -> Option<f64> {
+        self.frame_time.map(|f| self.start + k as f64 * f)
+    }
 }
 
 impl BallState {
@@ -294,10 +305,26 @@ pub trait World {
     fn for_each_neighbor(&self, i: u32, f: &mut dyn FnMut(u32));
 }
 
-/// Receives every executed physical event, in execution order, with the state just after it.
+/// One frame of the display (thesis 4.2): every ball as it is at time `t`, after every event of
+/// that instant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// The frame's time.
+    pub t: f64,
+    /// Every ball, fixed at `t` (a pocketed ball keeps its entry fix and names its pocket).
+    pub balls: Vec<BallState>,
+}
+
+/// Receives every executed physical event, in execution order, with the state just after it,
+/// and the frames of the display when the run makes them.
 pub trait Observer {
     /// Called after each event; an error stops the run.
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError>;
+
+    /// Called with each frame, in time order, when the run was asked for frames.
+    fn on_frame(&mut self, _frame: &Frame, _table: &Table) -> Result<(), RunError> {
+        Ok(())
+    }
 }
 
 /// An observer that ignores everything.
@@ -309,17 +336,13 @@ impl Observer for Ignore {
     }
 }
 
-/// Observers chained: each sees every event in turn.
-impl<A: Observer, B: Observer> Observer for (A, B) {
-    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
-        self.0.on_event(ev, world)?;
-        self.1.on_event(ev, world)
-    }
-}
-
 impl<O: Observer + ?Sized> Observer for &mut O {
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
         (**self).on_event(ev, world)
+    }
+
+    fn on_frame(&mut self, frame: &Frame, table: &Table) -> Result<(), RunError> {
+        (**self).on_frame(frame, table)
     }
 }
 

@@ -2,10 +2,10 @@
 //! sequential kernel executor. With zero NewVelocity delay it executes exactly the event-list
 //! engine's physical events.
 
-use super::{BallState, EventCounts, Observer, Outcome, RunError, Span, Table, World};
+use super::{BallState, EventCounts, Frame, Observer, Outcome, RunError, Span, Table, World};
 use crate::kernel::sequential::Sequential;
 use crate::kernel::{MessageStats, Model, VTime};
-use crate::model::pool::{NvDelay, Pool, PoolState};
+use crate::model::pool::{NvDelay, Pool, PoolOutput, PoolState};
 use crate::scenario::Scenario;
 use crate::vtime::Key;
 
@@ -37,7 +37,7 @@ impl World for View<'_> {
                 mass: info.mass,
                 pocket: info.pocket,
             },
-            PoolState::Fixed { .. } => unreachable!("objects below n_balls are balls"),
+            _ => unreachable!("objects below n_balls are balls"),
         }
     }
 
@@ -65,14 +65,38 @@ impl Objects {
     /// Runs every batch up to time `until`, reporting each physical event to `obs`.
     pub fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
         let mut counts = EventCounts::default();
-        self.exec.run(until, &mut |model: &Pool, states, ev| {
-            counts.add(ev.kind);
-            let view = View {
-                table: model.table(),
-                states,
-            };
-            obs.on_event(&ev, &view)
-        })?;
+        let n = self.exec.model().table().n_balls as usize;
+        // A frame is complete when every ball has drawn itself for it.
+        let mut frame: Option<Frame> = None;
+        self.exec
+            .run(until, &mut |model: &Pool, states, out| match out {
+                PoolOutput::Event(ev) => {
+                    counts.add(ev.kind);
+                    let view = View {
+                        table: model.table(),
+                        states,
+                    };
+                    obs.on_event(&ev, &view)
+                }
+                PoolOutput::Draw { t, ball, state } => {
+                    let f = frame.get_or_insert_with(|| Frame {
+                        t,
+                        balls: Vec::with_capacity(n),
+                    });
+                    debug_assert_eq!(f.balls.len(), ball as usize, "balls draw in order");
+                    f.balls.push(BallState {
+                        traj: state.traj,
+                        radius: state.radius,
+                        mass: state.mass,
+                        pocket: state.pocket,
+                    });
+                    if f.balls.len() == n {
+                        let done = frame.take().expect("a frame is being drawn");
+                        obs.on_frame(&done, model.table())?;
+                    }
+                    Ok(())
+                }
+            })?;
         let view = View {
             table: self.exec.model().table(),
             states: self.exec.states(),

@@ -10,6 +10,7 @@
 //!
 //!   Ball ──ReverseYourself──► itself (at the reversal, 4.6)
 //!   Ball ──ReturnToTable────► itself (a pocketed ball comes back out, fig. 13)
+//!   Projector ──DisplayYourself──► every object, and itself at the next frame time (4.2)
 //! ```
 //!
 //! When a ball changes velocity it cancels the collisions it scheduled and tells every other
@@ -36,7 +37,7 @@ use crate::geometry::Trajectory;
 use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
-use crate::vtime::{pair, Key, REVERSAL};
+use crate::vtime::{pair, Key, DISPLAY, REVERSAL};
 use std::sync::Arc;
 
 /// What a ball tells others about itself.
@@ -71,6 +72,24 @@ pub enum PoolMsg {
     ReverseYourself,
     /// Come back out of the pocket now (thesis fig. 13), sent by a pocketed ball to itself.
     ReturnToTable,
+    /// Draw yourself (thesis 4.2), sent by the Projector every frame time.
+    DisplayYourself,
+}
+
+/// What the pool objects report.
+#[derive(Clone, Debug)]
+pub enum PoolOutput {
+    /// A physical event.
+    Event(Event),
+    /// A ball drawing itself for the frame at `t`.
+    Draw {
+        /// The frame's time.
+        t: f64,
+        /// The ball.
+        ball: u32,
+        /// Its state, fixed at `t`.
+        state: BallInfo,
+    },
 }
 
 /// Type indices of the messages, for the statistics.
@@ -81,6 +100,8 @@ pub const COLLISION: usize = 1;
 pub const REVERSE_YOURSELF: usize = 2;
 /// See [`NEW_VELOCITY`].
 pub const RETURN_TO_TABLE: usize = 3;
+/// See [`NEW_VELOCITY`].
+pub const DISPLAY_YOURSELF: usize = 4;
 
 /// One collision an object scheduled: the partner and the two Collision messages.
 #[derive(Clone, Debug)]
@@ -109,6 +130,11 @@ pub enum PoolState {
         planned: Vec<Planned>,
         /// Balls it holds (pockets only), in the order they dropped in.
         holds: Vec<u32>,
+    },
+    /// The Projector: the frames it has shown.
+    Projector {
+        /// Frames shown so far.
+        frames: u64,
     },
 }
 
@@ -157,6 +183,9 @@ impl Pool {
                 holds: Vec::new(),
             });
         }
+        if span.frame_time.is_some() {
+            states.push(PoolState::Projector { frames: 0 });
+        }
         (Pool { table, delay, span }, states)
     }
 
@@ -165,9 +194,17 @@ impl Pool {
         &self.table
     }
 
-    /// The number of objects.
+    /// The number of table objects (balls and fixed objects; the Projector comes after them).
     pub fn n_objects(&self) -> u32 {
         self.table.n_balls + self.table.n_fixed()
+    }
+
+    /// The Projector's next frame: a DisplayYourself to itself.
+    fn next_frame(&self, ctx: &mut Ctx<'_, Pool>, me: u32, frames: &mut u64) {
+        if let Some(t) = self.span.frame(*frames) {
+            *frames += 1;
+            ctx.send_at(me, VTime::at(Key::at(t, DISPLAY)), PoolMsg::DisplayYourself);
+        }
     }
 
     /// The virtual time at which a NewVelocity sent now to `to` arrives.
@@ -324,7 +361,7 @@ impl Pool {
                     me_info.fixed = now.key.clone();
                     changed = true;
                     if let Some((kind, a, b)) = kind {
-                        ctx.emit(Event { t, kind, a, b });
+                        ctx.emit(PoolOutput::Event(Event { t, kind, a, b }));
                     }
                 }
                 PoolMsg::ReverseYourself => {
@@ -348,6 +385,15 @@ impl Pool {
                     }
                     me_info.traj.velocity = -me_info.traj.velocity;
                 }
+                PoolMsg::DisplayYourself => {
+                    let t = ctx.now().t();
+                    let mut state = (**info).clone();
+                    if state.pocket.is_none() {
+                        state.traj.position = state.traj.at(t);
+                        state.traj.t0 = t;
+                    }
+                    ctx.emit(PoolOutput::Draw { t, ball: me, state });
+                }
                 PoolMsg::ReturnToTable => {
                     let now = ctx.now().clone();
                     let me_info = Arc::make_mut(info);
@@ -355,12 +401,12 @@ impl Pool {
                     me_info.fixed = now.key.clone();
                     changed = true;
                     let f = self.table.fixed_id(Fixed::Pocket(k));
-                    ctx.emit(Event {
+                    ctx.emit(PoolOutput::Event(Event {
                         t: now.t(),
                         kind: EventKind::BallPocket,
                         a: me,
                         b: f,
-                    });
+                    }));
                 }
                 PoolMsg::NewVelocity(x) => {
                     let from = env.from;
@@ -424,6 +470,7 @@ impl Pool {
                         holds.push(*partner);
                     }
                 }
+                PoolMsg::DisplayYourself => {} // a fixed object looks the same in every frame
                 PoolMsg::ReverseYourself | PoolMsg::ReturnToTable => {
                     unreachable!("only balls are told to reverse or return")
                 }
@@ -485,7 +532,7 @@ fn overlapping_and_closing(a: &BallInfo, b: &BallInfo, t: f64) -> bool {
 impl Model for Pool {
     type Msg = PoolMsg;
     type State = PoolState;
-    type Output = Event;
+    type Output = PoolOutput;
 
     fn kind_names(&self) -> &'static [&'static str] {
         &[
@@ -493,6 +540,7 @@ impl Model for Pool {
             "Collision",
             "ReverseYourself",
             "ReturnToTable",
+            "DisplayYourself",
         ]
     }
 
@@ -502,6 +550,7 @@ impl Model for Pool {
             PoolMsg::Collision { .. } => COLLISION,
             PoolMsg::ReverseYourself => REVERSE_YOURSELF,
             PoolMsg::ReturnToTable => RETURN_TO_TABLE,
+            PoolMsg::DisplayYourself => DISPLAY_YOURSELF,
         }
     }
 
@@ -512,22 +561,27 @@ impl Model for Pool {
             PoolMsg::ReturnToTable => 1,
             PoolMsg::NewVelocity(_) => 2,
             PoolMsg::ReverseYourself => 3,
+            PoolMsg::DisplayYourself => 4,
         }
     }
 
     /// Thesis 4.1: each ball tells the higher-numbered balls and every fixed object its initial
     /// trajectory, so every pair is scheduled once.
     fn init(&self, ctx: &mut Ctx<'_, Pool>, me: u32, state: &mut PoolState) {
-        if let PoolState::Ball { info, .. } = state {
-            let n = self.n_objects();
-            self.broadcast(ctx, me, info, me + 1..n);
-            if let Some(t) = self.span.reverse_at {
-                ctx.send_at(
-                    me,
-                    VTime::at(Key::at(t, REVERSAL)),
-                    PoolMsg::ReverseYourself,
-                );
+        match state {
+            PoolState::Ball { info, .. } => {
+                let n = self.n_objects();
+                self.broadcast(ctx, me, info, me + 1..n);
+                if let Some(t) = self.span.reverse_at {
+                    ctx.send_at(
+                        me,
+                        VTime::at(Key::at(t, REVERSAL)),
+                        PoolMsg::ReverseYourself,
+                    );
+                }
             }
+            PoolState::Projector { frames } => self.next_frame(ctx, me, frames),
+            PoolState::Fixed { .. } => {}
         }
     }
 
@@ -541,6 +595,12 @@ impl Model for Pool {
         match state {
             PoolState::Ball { info, planned } => self.ball_batch(ctx, me, info, planned, batch),
             PoolState::Fixed { planned, holds } => self.fixed_batch(ctx, me, planned, holds, batch),
+            PoolState::Projector { frames } => {
+                for to in 0..self.n_objects() {
+                    ctx.send_now(to, PoolMsg::DisplayYourself);
+                }
+                self.next_frame(ctx, me, frames);
+            }
         }
     }
 }
