@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use poolsim::engine::{Event, Observer, RunError, World};
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};
-use poolsim::run::{execute, EngineKind, RunConfig};
+use poolsim::run::{execute, EngineKind, RunConfig, SectorChoice};
 use poolsim::scenario::{self, builtin, Scenario};
 use std::fs::File;
 use std::io::{BufWriter, IsTerminal};
@@ -398,6 +398,32 @@ fn nv_delay(arg: Option<&str>, s: &Scenario) -> Result<NvDelay, Failure> {
     })
 }
 
+/// `--sectors`: none, auto, N (N x N) or NxM; absent means the scenario's own `[sectors]`, if
+/// any.
+fn sector_choice(arg: Option<&str>, s: &Scenario) -> Result<Option<SectorChoice>, Failure> {
+    let bad = |text: &str| {
+        usage(format!(
+            "--sectors: expected none, auto, N or NxM (sectors per side), got `{text}`"
+        ))
+    };
+    let count = |text: &str| match text.parse::<u32>() {
+        Ok(n) if (1..=10_000).contains(&n) => Ok(n),
+        _ => Err(bad(text)),
+    };
+    Ok(match arg {
+        None => s.sectors.as_ref().map(|_| SectorChoice::Scenario),
+        Some("none") => None,
+        Some("auto") => Some(SectorChoice::Auto),
+        Some(text) => match text.split_once(['x', 'X']) {
+            Some((nx, ny)) => Some(SectorChoice::Grid(count(nx)?, count(ny)?)),
+            None => {
+                let n = count(text)?;
+                Some(SectorChoice::Grid(n, n))
+            }
+        },
+    })
+}
+
 fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
     match a.engine.as_str() {
         "event-list" => {
@@ -415,14 +441,19 @@ fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
             Ok(EngineKind::TimeStep { dt })
         }
         "objects" => {
-            if let Some(s) = a.sectors.as_deref().filter(|s| *s != "none") {
-                return Err(usage(format!(
-                    "--sectors: `{s}` is not built yet; the objects engine runs with --sectors none"
-                )));
+            let delay = nv_delay(a.newvelocity_delay.as_deref(), scenario)?;
+            match sector_choice(a.sectors.as_deref(), scenario)? {
+                None => Ok(EngineKind::Objects { delay }),
+                Some(_) if delay != NvDelay::Exact => Err(usage(
+                    "--newvelocity-delay: the thesis' delay runs on non-sectored tables only \
+                     (--sectors none)",
+                )),
+                Some(sectors) => {
+                    poolsim::run::sector_layout(scenario, sectors)
+                        .map_err(|e| usage(format!("--sectors: {e}")))?;
+                    Ok(EngineKind::Sectored { sectors })
+                }
             }
-            Ok(EngineKind::Objects {
-                delay: nv_delay(a.newvelocity_delay.as_deref(), scenario)?,
-            })
         }
         "time-warp" => Err(usage(
             "--engine: `time-warp` is not built yet; available: event-list, time-step, objects",
@@ -436,7 +467,10 @@ fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
 fn run(a: &RunArgs) -> Result<(), Failure> {
     let scenario = load(&a.scenario, &a.gen)?;
     let engine = engine_of(a, &scenario)?;
-    let objects = matches!(engine, EngineKind::Objects { .. });
+    let objects = matches!(
+        engine,
+        EngineKind::Objects { .. } | EngineKind::Sectored { .. }
+    );
     for (flag, given) in [
         ("--sectors", a.sectors.is_some() && !objects),
         (
@@ -489,7 +523,10 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         t.finish()
             .map_err(|e| internal(format!("writing the trace failed: {e}")))?;
     }
-    let report = report.map_err(|e| internal(e.to_string()))?;
+    let report = report.map_err(|e| match e {
+        RunError::Input(m) => usage(m),
+        e => internal(e.to_string()),
+    })?;
     if let Some(p) = &a.final_state {
         let fs = FinalState::new(report.outcome.t, &report.outcome.balls);
         let text = serde_json::to_string_pretty(&fs).expect("a final state serializes");

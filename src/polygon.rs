@@ -414,8 +414,8 @@ pub fn touches(poly: &Polygon, centre: Vec2, r: f64) -> bool {
 /// radius `r` moving on `traj` touches the polygon, over the whole line of the motion (before
 /// `traj.t0` too). A disk at rest gives `[(-∞, ∞)]` when it touches and nothing otherwise.
 ///
-/// Intervals closer than a relative `1e-10` of the polygon's size (in distance travelled) are
-/// joined, so that rounding never splits one contact in two; a ball is then taken to touch a
+/// Intervals closer than `1e-10` times the polygon's largest coordinate (in distance travelled)
+/// are joined, so that rounding never splits one contact in two; a ball is then taken to touch a
 /// little longer than it does, which is harmless (DESIGN.md: membership may be conservative).
 pub fn touch_intervals(poly: &Polygon, traj: &Trajectory, r: f64) -> Vec<(f64, f64)> {
     if traj.velocity == Vec2::ZERO {
@@ -500,7 +500,7 @@ fn intervals(poly: &Polygon, traj: &Trajectory, r: f64) -> SmallVec<[(f64, f64);
                 pieces.push((t0, t1));
             }
         }
-        if let Some(c) = circle_range(p - a, v, r).filter(|_| false) {
+        if let Some(c) = circle_range(p - a, v, r) {
             pieces.push(c);
         }
     }

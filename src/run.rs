@@ -9,6 +9,9 @@ use crate::engine::objects::Objects;
 use crate::engine::time_step::{self, TimeStep};
 use crate::engine::{BallState, Event, Frame, Observer, Outcome, RunError, Span, Table, World};
 use crate::model::pool::NvDelay;
+use crate::model::sectored::Layout;
+use crate::polygon::Polygon;
+use crate::scenario::SectorSpec;
 use crate::output::{digest, events_json};
 use crate::physics::kinetic_energy;
 use crate::scenario::Scenario;
@@ -30,6 +33,45 @@ pub enum EngineKind {
         /// How NewVelocity messages travel.
         delay: NvDelay,
     },
+    /// The objects engine on a sectored table (thesis fig. 14), sequential.
+    Sectored {
+        /// How the table is cut into sectors.
+        sectors: SectorChoice,
+    },
+}
+
+/// How a sectored run cuts the table (`--sectors`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SectorChoice {
+    /// A grid from the analytic model of chapter 7: about eight balls per sector.
+    Auto,
+    /// An `nx` × `ny` grid over the table's box.
+    Grid(u32, u32),
+    /// The scenario's own `[sectors]` (a grid or polygons).
+    Scenario,
+}
+
+/// The sector layout a choice gives on a scenario, or what is wrong with it.
+pub fn sector_layout(s: &Scenario, choice: SectorChoice) -> Result<Layout, String> {
+    let table = Table::new(s);
+    Ok(match choice {
+        SectorChoice::Auto => Layout::auto(&table, s.balls.len()),
+        SectorChoice::Grid(nx, ny) => Layout::grid(&table, nx, ny),
+        SectorChoice::Scenario => match &s.sectors {
+            None => return Err("the scenario has no [sectors]".into()),
+            Some(SectorSpec::Grid { nx, ny }) => Layout::grid(&table, *nx, *ny),
+            Some(SectorSpec::Polygons(polys)) => {
+                let mut out = Vec::new();
+                for (k, p) in polys.iter().enumerate() {
+                    out.push(
+                        Polygon::new(p.clone())
+                            .map_err(|e| format!("sectors.polygon[{}]: {e}", k + 1))?,
+                    );
+                }
+                Layout::new(out, &table)?
+            }
+        },
+    })
 }
 
 impl EngineKind {
@@ -38,7 +80,7 @@ impl EngineKind {
         match self {
             EngineKind::EventList => "event-list",
             EngineKind::TimeStep { .. } => "time-step",
-            EngineKind::Objects { .. } => "objects",
+            EngineKind::Objects { .. } | EngineKind::Sectored { .. } => "objects",
         }
     }
 }
@@ -135,6 +177,16 @@ pub fn execute(
         }
         EngineKind::Objects { delay } => {
             let mut e = Objects::new(scenario, delay, cfg.span);
+            e.run(cfg.until, &mut sinks)?
+        }
+        EngineKind::Sectored { sectors } => {
+            if cfg.span != Span::default() {
+                return Err(RunError::Input(
+                    "reversal and frames are not available on sectored tables yet".into(),
+                ));
+            }
+            let layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
+            let mut e = Objects::sectored(scenario, layout);
             e.run(cfg.until, &mut sinks)?
         }
     };

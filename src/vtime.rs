@@ -22,7 +22,12 @@ pub type Pair = u64;
 
 /// The pair code of a reversal of every ball (thesis 4.6): it runs after every physical event of
 /// its instant.
-pub const REVERSAL: Pair = u64::MAX - 2;
+pub const REVERSAL: Pair = u64::MAX - 3;
+
+/// The pair code of a ball leaving a sector (thesis 5.1): after every physical event and the
+/// reversal of its instant, so that membership is never given up early. (Entries use the empty
+/// path, before everything of their instant.)
+pub const DEPARTURE: Pair = u64::MAX - 2;
 
 /// The pair code of a frame of the display (thesis 4.2): after the reversal, if any, so that a
 /// frame shows the state after everything at its time.

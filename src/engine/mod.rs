@@ -360,6 +360,8 @@ pub enum RunError {
     },
     /// An observer's output failed (a trace file could not be written).
     Output(String),
+    /// The run was asked for something the input does not allow (a bad sector layout).
+    Input(String),
 }
 
 impl fmt::Display for RunError {
@@ -372,6 +374,7 @@ impl fmt::Display for RunError {
                  instantaneous collisions that does not end"
             ),
             RunError::Output(m) => write!(f, "output failed: {m}"),
+            RunError::Input(m) => write!(f, "{m}"),
         }
     }
 }

@@ -1,26 +1,53 @@
-//! The objects engine (thesis fig. 3): the pool objects of [`crate::model::pool`] run by the
-//! sequential kernel executor. With zero NewVelocity delay it executes exactly the event-list
-//! engine's physical events.
+//! The objects engine (thesis fig. 3 and 14): the pool objects of [`crate::model::pool`], or the
+//! sectored ones of [`crate::model::sectored`], run by the sequential kernel executor. With zero
+//! NewVelocity delay it executes exactly the event-list engine's physical events.
 
 use super::{BallState, EventCounts, Frame, Observer, Outcome, RunError, Span, Table, World};
 use crate::kernel::sequential::Sequential;
 use crate::kernel::{MessageStats, Model, VTime};
-use crate::model::pool::{NvDelay, Pool, PoolOutput, PoolState};
+use crate::model::pool::{BallInfo, NvDelay, Pool, PoolOutput, PoolState};
+use crate::model::sectored::{Layout, SecState, Sectored};
 use crate::scenario::Scenario;
 use crate::vtime::Key;
 
-/// The objects engine over one scenario.
-pub struct Objects {
-    exec: Sequential<Pool>,
+/// The objects engine over one scenario: plain or sectored.
+pub enum Objects {
+    /// Every ball tells every object (thesis fig. 3).
+    Plain(Sequential<Pool>),
+    /// Sectors relay (thesis fig. 14).
+    Sectored(Sequential<Sectored>),
 }
 
-/// A read-only view of the pool objects' states for observers.
-struct View<'a> {
+/// The ball part of an object's state.
+trait BallOf {
+    fn ball_info(&self) -> &BallInfo;
+}
+
+impl BallOf for PoolState {
+    fn ball_info(&self) -> &BallInfo {
+        match self {
+            PoolState::Ball { info, .. } => info,
+            _ => unreachable!("objects below n_balls are balls"),
+        }
+    }
+}
+
+impl BallOf for SecState {
+    fn ball_info(&self) -> &BallInfo {
+        match self {
+            SecState::Ball { info, .. } => info,
+            _ => unreachable!("objects below n_balls are balls"),
+        }
+    }
+}
+
+/// A read-only view of the objects' states for observers.
+struct View<'a, S> {
     table: &'a Table,
-    states: &'a [PoolState],
+    states: &'a [S],
 }
 
-impl World for View<'_> {
+impl<S: BallOf> World for View<'_, S> {
     fn table(&self) -> &Table {
         self.table
     }
@@ -30,14 +57,12 @@ impl World for View<'_> {
     }
 
     fn ball(&self, i: u32) -> BallState {
-        match &self.states[i as usize] {
-            PoolState::Ball { info, .. } => BallState {
-                traj: info.traj,
-                radius: info.radius,
-                mass: info.mass,
-                pocket: info.pocket,
-            },
-            _ => unreachable!("objects below n_balls are balls"),
+        let info = self.states[i as usize].ball_info();
+        BallState {
+            traj: info.traj,
+            radius: info.radius,
+            mass: info.mass,
+            pocket: info.pocket,
         }
     }
 
@@ -49,26 +74,109 @@ impl World for View<'_> {
 }
 
 impl Objects {
-    /// Sets the objects up at `span.start` (their `init` sends the first NewVelocity messages).
+    /// Sets the plain objects up at `span.start` (their `init` sends the first NewVelocity
+    /// messages).
     pub fn new(s: &Scenario, delay: NvDelay, span: Span) -> Objects {
         let (model, states) = Pool::new(s, delay, span);
-        Objects {
-            exec: Sequential::new(model, states, VTime::at(Key::start(span.start))),
-        }
+        Objects::Plain(Sequential::new(
+            model,
+            states,
+            VTime::at(Key::start(span.start)),
+        ))
+    }
+
+    /// Sets the sectored objects up at time 0 over `layout`.
+    pub fn sectored(s: &Scenario, layout: Layout) -> Objects {
+        let (model, states) = Sectored::new(s, layout);
+        Objects::Sectored(Sequential::new(model, states, VTime::at(Key::start(0.0))))
     }
 
     /// Message statistics so far.
     pub fn stats(&self) -> &MessageStats {
-        self.exec.stats()
+        match self {
+            Objects::Plain(e) => e.stats(),
+            Objects::Sectored(e) => e.stats(),
+        }
     }
 
     /// Runs every batch up to time `until`, reporting each physical event to `obs`.
     pub fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
+        match self {
+            Objects::Plain(e) => run_plain(e, until, obs),
+            Objects::Sectored(e) => {
+                let mut counts = EventCounts::default();
+                e.run(until, &mut |model: &Sectored, states, ev| {
+                    counts.add(ev.kind);
+                    let view = View {
+                        table: model.table(),
+                        states,
+                    };
+                    obs.on_event(&ev, &view)
+                })?;
+                Ok(outcome(e, e.model().table(), until, counts))
+            }
+        }
+    }
+}
+
+/// The end of a run of either model: balls at `until` and the message counts.
+fn outcome<M: Model>(
+    e: &Sequential<M>,
+    table: &Table,
+    until: f64,
+    counts: EventCounts,
+) -> Outcome
+where
+    M::State: BallOf,
+{
+    let view = View {
+        table,
+        states: e.states(),
+    };
+    let balls = (0..view.n_balls() as u32)
+        .map(|i| {
+            let mut b = view.ball(i);
+            if b.pocket.is_none() {
+                b.traj.position = b.traj.at(until);
+                b.traj.t0 = until;
+            }
+            b
+        })
+        .collect();
+    let stats = e.stats();
+    let mut messages: Vec<(&'static str, u64)> = e
+        .model()
+        .kind_names()
+        .iter()
+        .enumerate()
+        .map(|(k, n)| (*n, stats.get(k)))
+        .collect();
+    messages.push(("Cancel", stats.cancels));
+    Outcome {
+        t: until,
+        balls,
+        events: counts,
+        engine_stats: vec![
+            ("batches", stats.batches as f64),
+            ("messages_delivered", stats.delivered as f64),
+            ("pending_at_end", e.pending_len() as f64),
+        ],
+        messages,
+    }
+}
+
+/// Runs the plain objects, assembling the Projector's frames.
+fn run_plain(
+    exec: &mut Sequential<Pool>,
+    until: f64,
+    obs: &mut dyn Observer,
+) -> Result<Outcome, RunError> {
+    {
         let mut counts = EventCounts::default();
-        let n = self.exec.model().table().n_balls as usize;
+        let n = exec.model().table().n_balls as usize;
         // A frame is complete when every ball has drawn itself for it.
         let mut frame: Option<Frame> = None;
-        self.exec
+        exec
             .run(until, &mut |model: &Pool, states, out| match out {
                 PoolOutput::Event(ev) => {
                     counts.add(ev.kind);
@@ -97,38 +205,6 @@ impl Objects {
                     Ok(())
                 }
             })?;
-        let view = View {
-            table: self.exec.model().table(),
-            states: self.exec.states(),
-        };
-        let balls = (0..view.n_balls() as u32)
-            .map(|i| {
-                let mut b = view.ball(i);
-                if b.pocket.is_none() {
-                    b.traj.position = b.traj.at(until);
-                    b.traj.t0 = until;
-                }
-                b
-            })
-            .collect();
-        let stats = self.exec.stats();
-        let names = self.exec.model().kind_names();
-        let mut messages: Vec<(&'static str, u64)> = names
-            .iter()
-            .enumerate()
-            .map(|(k, n)| (*n, stats.get(k)))
-            .collect();
-        messages.push(("Cancel", stats.cancels));
-        Ok(Outcome {
-            t: until,
-            balls,
-            events: counts,
-            engine_stats: vec![
-                ("batches", stats.batches as f64),
-                ("messages_delivered", stats.delivered as f64),
-                ("pending_at_end", self.exec.pending_len() as f64),
-            ],
-            messages,
-        })
+        Ok(outcome(exec, exec.model().table(), until, counts))
     }
 }

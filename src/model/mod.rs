@@ -3,3 +3,4 @@
 
 pub mod phold;
 pub mod pool;
+pub mod sectored;

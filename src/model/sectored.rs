@@ -1,0 +1,809 @@
+//! The sectored pool simulation (thesis ch. 5, fig. 14 and 15): the table is cut into sectors of
+//! any polygon shape, and sectors relay a ball's new trajectory only to the balls near it.
+//!
+//! ```text
+//!        VelocityChange                 NewVelocity                Collision
+//!  Ball ───────────────► its Sectors ─────────────► their Balls ─────────────► Ball (and itself)
+//!    │                        │        NewVelocity                SectorEntry
+//!    │                        └──────────────────► adjacent Sectors ─────────► Ball (and itself)
+//!    │  NewVelocity                                  SectorDeparture
+//!    └──────────────► Cushions, Pockets, Corners     Sector ────────────────► Ball (and itself)
+//! ```
+//!
+//! A sector knows every ball whose disk touches it: it enters at the first instant it touches
+//! (keyed before everything else of that instant) and leaves after everything of the instant it
+//! stops touching. Any two balls that collide touch a common sector at that moment, so one of them
+//! hears of the other's trajectory there in time: through a velocity change relayed by a sector
+//! they share, or when one enters a sector the other is in. Fixed objects hear of every change
+//! directly, as in the plain simulation.
+//!
+//! Beyond the thesis: a ball may hold a collision that a ball it no longer shares a sector with
+//! scheduled, so it would never hear that the other changed course. Each Collision therefore
+//! carries the trajectory versions it was computed from, and the two balls exchange a
+//! CollisionConfirm with zero delay before acting: the collision happens only if both are still
+//! on the trajectories it was predicted for. With zero delays the physical events are then exactly
+//! those of the event-list engine.
+
+use super::pool::{BallInfo, Planned};
+use crate::engine::{Event, EventKind, Fixed, Table};
+use crate::geometry::{Trajectory, Vec2};
+use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
+use crate::physics::{self, Contact};
+use crate::polygon::{self, Polygon};
+use crate::scenario::Scenario;
+use crate::vtime::{pair, Key, DEPARTURE};
+use std::sync::Arc;
+
+/// The sectors of a table: their polygons and which touch which.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    /// The sectors, `Sector-1` first.
+    pub polys: Vec<Polygon>,
+    /// For each sector, the sectors whose boundaries meet its own (an edge or a corner).
+    pub adjacent: Vec<Vec<u32>>,
+}
+
+impl Layout {
+    /// A layout of the given polygons, which must cover the table's box without overlapping.
+    pub fn new(polys: Vec<Polygon>, table: &Table) -> Result<Layout, String> {
+        polygon::validate_layout(&polys, table.lo, table.hi)?;
+        let size = (table.hi - table.lo).norm();
+        let adjacent = polygon::adjacency(&polys, 1e-9 * size);
+        Ok(Layout { polys, adjacent })
+    }
+
+    /// An `nx` × `ny` grid over the table's box.
+    pub fn grid(table: &Table, nx: u32, ny: u32) -> Layout {
+        Layout::new(polygon::grid(table.lo, table.hi, nx, ny), table)
+            .expect("a grid covers its box exactly")
+    }
+
+    /// The grid the analytic model suggests (thesis ch. 7): square-ish sectors holding about
+    /// eight balls each, the upper bound on the best size.
+    pub fn auto(table: &Table, balls: usize) -> Layout {
+        let span = table.hi - table.lo;
+        let side = (8.0 * span.x * span.y / balls.max(1) as f64).sqrt();
+        let nx = ((span.x / side).round() as u32).max(1);
+        let ny = ((span.y / side).round() as u32).max(1);
+        Layout::grid(table, nx, ny)
+    }
+
+    /// The sectors a disk at `centre` with radius `r` touches.
+    pub fn touching(&self, centre: Vec2, r: f64) -> Vec<u32> {
+        (0..self.polys.len() as u32)
+            .filter(|&k| polygon::touches(&self.polys[k as usize], centre, r))
+            .collect()
+    }
+}
+
+/// Messages of the sectored simulation.
+#[derive(Clone, Debug)]
+pub enum SecMsg {
+    /// A ball's trajectory, relayed by a sector or sent to a fixed object.
+    NewVelocity {
+        /// The ball.
+        ball: u32,
+        /// Its trajectory.
+        info: Arc<BallInfo>,
+    },
+    /// A scheduled collision of the receiver with `partner`.
+    Collision {
+        /// The other object.
+        partner: u32,
+        /// The partner ball's trajectory as the scheduler knew it.
+        info: Option<Arc<BallInfo>>,
+        /// The receiver's trajectory version as the scheduler knew it.
+        seen: Key,
+    },
+    /// Before a ball–ball collision: is the sender still on the trajectory it was predicted for?
+    CollisionConfirm {
+        /// Whether the sender's own trajectory is still the one the collision was computed for.
+        valid: bool,
+        /// The sender's current trajectory.
+        info: Arc<BallInfo>,
+    },
+    /// A ball tells a sector it occupies that it changed velocity.
+    VelocityChange {
+        /// The ball.
+        ball: u32,
+        /// Its new trajectory.
+        info: Arc<BallInfo>,
+    },
+    /// A ball tells a sector it occupies its initial trajectory (thesis 5.4).
+    VelocityInitialization {
+        /// The ball.
+        ball: u32,
+        /// Its trajectory.
+        info: Arc<BallInfo>,
+    },
+    /// A ball's disk starts touching a sector.
+    SectorEntry {
+        /// The ball.
+        ball: u32,
+        /// The sector.
+        sector: u32,
+    },
+    /// A ball's disk stops touching a sector.
+    SectorDeparture {
+        /// The ball.
+        ball: u32,
+        /// The sector.
+        sector: u32,
+    },
+}
+
+const KIND_NAMES: [&str; 7] = [
+    "NewVelocity",
+    "Collision",
+    "VelocityChange",
+    "SectorEntry",
+    "SectorDeparture",
+    "VelocityInitialization",
+    "CollisionConfirm",
+];
+
+/// A sector's scheduled entry or departure of one ball.
+#[derive(Clone, Debug)]
+pub struct Passage {
+    /// The ball.
+    pub ball: u32,
+    /// Whether it is an entry (else a departure).
+    pub entry: bool,
+    /// The ball's trajectory it was computed from.
+    pub info: Arc<BallInfo>,
+    /// The message to the sector itself.
+    pub own: Handle,
+    /// The message to the ball.
+    pub other: Handle,
+}
+
+/// An object's state in the sectored simulation.
+#[derive(Clone, Debug)]
+pub enum SecState {
+    /// A ball.
+    Ball {
+        /// Its trajectory.
+        info: Arc<BallInfo>,
+        /// Collisions it scheduled.
+        planned: Vec<Planned>,
+        /// Sectors its disk touches.
+        sectors: Vec<u32>,
+        /// Ball–ball collisions awaiting the partner's confirmation: partner, own validity.
+        awaiting: Vec<(u32, bool)>,
+    },
+    /// A cushion, pocket or corner.
+    Fixed {
+        /// Collisions it scheduled.
+        planned: Vec<Planned>,
+    },
+    /// A sector.
+    Sector {
+        /// Balls whose disks touch it, with their trajectories as last heard.
+        members: Vec<(u32, Arc<BallInfo>)>,
+        /// Entries and departures it scheduled.
+        planned: Vec<Passage>,
+    },
+}
+
+/// The sectored pool model.
+pub struct Sectored {
+    table: Table,
+    layout: Layout,
+}
+
+impl Sectored {
+    /// The model and initial states of a validated scenario over `layout`, starting at 0.
+    pub fn new(s: &Scenario, layout: Layout) -> (Sectored, Vec<SecState>) {
+        let table = Table::new(s);
+        let n = table.n_balls;
+        let first_sector = n + table.n_fixed();
+        let mut members: Vec<Vec<(u32, Arc<BallInfo>)>> = vec![Vec::new(); layout.polys.len()];
+        let mut states: Vec<SecState> = Vec::new();
+        for (i, b) in s.balls.iter().enumerate() {
+            let info = Arc::new(BallInfo {
+                traj: Trajectory {
+                    position: b.position,
+                    velocity: b.velocity,
+                    t0: 0.0,
+                },
+                radius: b.radius,
+                mass: b.mass,
+                fixed: Key::start(0.0),
+                pocket: None,
+            });
+            let sectors: Vec<u32> = layout
+                .touching(b.position, b.radius)
+                .into_iter()
+                .map(|k| {
+                    members[k as usize].push((i as u32, info.clone()));
+                    first_sector + k
+                })
+                .collect();
+            states.push(SecState::Ball {
+                info,
+                planned: Vec::new(),
+                sectors,
+                awaiting: Vec::new(),
+            });
+        }
+        for _ in 0..table.n_fixed() {
+            states.push(SecState::Fixed {
+                planned: Vec::new(),
+            });
+        }
+        for m in members {
+            states.push(SecState::Sector {
+                members: m,
+                planned: Vec::new(),
+            });
+        }
+        (Sectored { table, layout }, states)
+    }
+
+    /// The table.
+    pub fn table(&self) -> &Table {
+        &self.table
+    }
+
+    /// The layout.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    fn first_sector(&self) -> u32 {
+        self.table.n_balls + self.table.n_fixed()
+    }
+
+    fn fixed_ids(&self) -> std::ops::Range<u32> {
+        self.table.n_balls..self.first_sector()
+    }
+
+    /// Schedules a collision of `me` with `partner` at `key`.
+    #[allow(clippy::too_many_arguments)]
+    fn schedule(
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        partner: u32,
+        key: Key,
+        mine: Option<Arc<BallInfo>>,
+        my_version: Key,
+        theirs: Option<Arc<BallInfo>>,
+        their_version: Key,
+    ) -> Planned {
+        let time = VTime::at(key);
+        let own = ctx.send_at(
+            me,
+            time.clone(),
+            SecMsg::Collision {
+                partner,
+                info: theirs,
+                seen: my_version,
+            },
+        );
+        let other = ctx.send_at(
+            partner,
+            time,
+            SecMsg::Collision {
+                partner: me,
+                info: mine,
+                seen: their_version,
+            },
+        );
+        Planned {
+            partner,
+            own,
+            other,
+        }
+    }
+
+    fn cancel_with(ctx: &mut Ctx<'_, Sectored>, planned: &mut Vec<Planned>, partner: u32) {
+        if let Some(k) = planned.iter().position(|p| p.partner == partner) {
+            let p = planned.swap_remove(k);
+            ctx.cancel(p.own);
+            ctx.cancel(p.other);
+        }
+    }
+
+    fn key_of(contact: Contact, parent: &Key, p: crate::vtime::Pair) -> Option<Key> {
+        match contact {
+            Contact::Never => None,
+            Contact::At(t) => Some(Key::at(t, p)),
+            Contact::Immediate => Some(parent.child(p)),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn ball_batch(
+        &self,
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        info: &mut Arc<BallInfo>,
+        planned: &mut Vec<Planned>,
+        sectors: &mut Vec<u32>,
+        awaiting: &mut Vec<(u32, bool)>,
+        batch: &[Envelope<SecMsg>],
+    ) {
+        let mut changed = false;
+        let mut seen_balls: Vec<u32> = Vec::new();
+        for env in batch {
+            match &env.msg {
+                SecMsg::Collision {
+                    partner,
+                    info: other,
+                    seen,
+                } => {
+                    if seen_balls.contains(partner) {
+                        continue; // scheduled twice: once is enough
+                    }
+                    seen_balls.push(*partner);
+                    if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
+                        planned.swap_remove(k);
+                    }
+                    let valid = info.fixed == *seen && info.pocket.is_none();
+                    if other.is_some() {
+                        ctx.send_now(
+                            *partner,
+                            SecMsg::CollisionConfirm {
+                                valid,
+                                info: info.clone(),
+                            },
+                        );
+                        awaiting.push((*partner, valid));
+                    } else if valid {
+                        self.hit_fixed(ctx, me, info, *partner);
+                        changed = true;
+                    }
+                }
+                SecMsg::CollisionConfirm { valid, info: other } => {
+                    let Some(k) = awaiting.iter().position(|a| a.0 == env.from) else {
+                        continue;
+                    };
+                    let (partner, mine) = awaiting.swap_remove(k);
+                    if mine && *valid {
+                        self.hit_ball(ctx, me, info, partner, other);
+                        changed = true;
+                    }
+                }
+                SecMsg::NewVelocity { ball, info: x } => {
+                    if seen_balls.contains(ball) {
+                        continue;
+                    }
+                    seen_balls.push(*ball);
+                    Self::cancel_with(ctx, planned, *ball);
+                    if info.pocket.is_some() || x.pocket.is_some() {
+                        continue;
+                    }
+                    if x.fixed == info.fixed && x.fixed == ctx.now().key && *ball > me {
+                        continue; // both changed at this key: the higher-numbered ball schedules
+                    }
+                    let (lo, hi) = if me < *ball {
+                        (&**info, &**x)
+                    } else {
+                        (&**x, &**info)
+                    };
+                    let contact =
+                        physics::ball_ball_contact(&lo.traj, lo.radius, &hi.traj, hi.radius);
+                    let parent = if info.fixed > x.fixed {
+                        &info.fixed
+                    } else {
+                        &x.fixed
+                    };
+                    if let Some(key) = Self::key_of(contact, parent, pair(me, *ball)) {
+                        let p = Self::schedule(
+                            ctx,
+                            me,
+                            *ball,
+                            key,
+                            Some(info.clone()),
+                            info.fixed.clone(),
+                            Some(x.clone()),
+                            x.fixed.clone(),
+                        );
+                        planned.push(p);
+                    }
+                }
+                SecMsg::SectorEntry { sector, .. } => {
+                    if !sectors.contains(sector) {
+                        sectors.push(*sector);
+                    }
+                }
+                SecMsg::SectorDeparture { sector, .. } => sectors.retain(|s| s != sector),
+                SecMsg::VelocityChange { .. } | SecMsg::VelocityInitialization { .. } => {
+                    unreachable!("balls are not told of velocity changes by balls")
+                }
+            }
+        }
+        if changed {
+            for p in planned.drain(..) {
+                ctx.cancel(p.own);
+                ctx.cancel(p.other);
+            }
+            for &s in sectors.iter() {
+                ctx.send_now(
+                    s,
+                    SecMsg::VelocityChange {
+                        ball: me,
+                        info: info.clone(),
+                    },
+                );
+            }
+            for f in self.fixed_ids() {
+                ctx.send_now(
+                    f,
+                    SecMsg::NewVelocity {
+                        ball: me,
+                        info: info.clone(),
+                    },
+                );
+            }
+            if info.pocket.is_some() {
+                sectors.clear();
+            }
+        }
+    }
+
+    /// Ball `me` collides with ball `partner` (on trajectory `other`) now.
+    fn hit_ball(
+        &self,
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        info: &mut Arc<BallInfo>,
+        partner: u32,
+        other: &BallInfo,
+    ) {
+        let now = ctx.now().clone();
+        let t = now.t();
+        let me_info = Arc::make_mut(info);
+        let p = me_info.traj.at(t);
+        let q = other.traj.at(t);
+        let v = if me < partner {
+            physics::ball_ball_velocities(
+                p,
+                me_info.traj.velocity,
+                me_info.mass,
+                q,
+                other.traj.velocity,
+                other.mass,
+            )
+            .0
+        } else {
+            physics::ball_ball_velocities(
+                q,
+                other.traj.velocity,
+                other.mass,
+                p,
+                me_info.traj.velocity,
+                me_info.mass,
+            )
+            .1
+        };
+        me_info.traj = Trajectory {
+            position: p,
+            velocity: v,
+            t0: t,
+        };
+        me_info.fixed = now.key.clone();
+        if me > partner {
+            ctx.emit(Event {
+                t,
+                kind: EventKind::BallBall,
+                a: partner,
+                b: me,
+            });
+        }
+    }
+
+    /// Ball `me` hits fixed object `f` now.
+    fn hit_fixed(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, info: &mut Arc<BallInfo>, f: u32) {
+        let now = ctx.now().clone();
+        let t = now.t();
+        let me_info = Arc::make_mut(info);
+        let p = me_info.traj.at(t);
+        match self.table.bounce(f, p, me_info.traj.velocity) {
+            Some(v) => me_info.traj.velocity = v,
+            None => {
+                let Fixed::Pocket(k) = self.table.fixed(f) else {
+                    unreachable!("only pockets swallow balls")
+                };
+                me_info.pocket = Some(k);
+            }
+        }
+        me_info.traj.position = p;
+        me_info.traj.t0 = t;
+        me_info.fixed = now.key.clone();
+        ctx.emit(Event {
+            t,
+            kind: self.table.event_kind(f),
+            a: me,
+            b: f,
+        });
+    }
+
+    fn fixed_batch(
+        &self,
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        planned: &mut Vec<Planned>,
+        batch: &[Envelope<SecMsg>],
+    ) {
+        for env in batch {
+            match &env.msg {
+                SecMsg::Collision { partner, .. } => {
+                    if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
+                        planned.swap_remove(k);
+                    }
+                }
+                SecMsg::NewVelocity { ball, info: x } => {
+                    Self::cancel_with(ctx, planned, *ball);
+                    if x.pocket.is_some() {
+                        continue;
+                    }
+                    let contact = self.table.contact(me, &x.traj, x.radius);
+                    if let Some(key) = Self::key_of(contact, &x.fixed, pair(*ball, me)) {
+                        let none = Key::start(f64::NEG_INFINITY);
+                        let p = Self::schedule(
+                            ctx,
+                            me,
+                            *ball,
+                            key,
+                            None,
+                            none,
+                            None,
+                            x.fixed.clone(),
+                        );
+                        planned.push(p);
+                    }
+                }
+                _ => unreachable!("fixed objects hear only of trajectories and collisions"),
+            }
+        }
+    }
+
+    /// Schedules ball `ball`'s entry into (or departure from) sector `me` at `time`.
+    fn passage(
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        ball: u32,
+        entry: bool,
+        time: VTime,
+        info: Arc<BallInfo>,
+    ) -> Passage {
+        let msg = if entry {
+            SecMsg::SectorEntry { ball, sector: me }
+        } else {
+            SecMsg::SectorDeparture { ball, sector: me }
+        };
+        let own = ctx.send_at(me, time.clone(), msg.clone());
+        let other = ctx.send_at(ball, time, msg);
+        Passage {
+            ball,
+            entry,
+            info,
+            own,
+            other,
+        }
+    }
+
+    /// Cancels the entry or departure of `ball` the sector planned, if any.
+    fn cancel_passage(ctx: &mut Ctx<'_, Sectored>, planned: &mut Vec<Passage>, ball: u32) {
+        if let Some(k) = planned.iter().position(|p| p.ball == ball) {
+            let p = planned.swap_remove(k);
+            ctx.cancel(p.own);
+            ctx.cancel(p.other);
+        }
+    }
+
+    /// A member's new trajectory: plan its departure and tell the balls here (those after
+    /// `after` only, at initialization) and the adjacent sectors.
+    #[allow(clippy::too_many_arguments)]
+    fn relay(
+        &self,
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        members: &[(u32, Arc<BallInfo>)],
+        planned: &mut Vec<Passage>,
+        ball: u32,
+        info: &Arc<BallInfo>,
+        after: Option<u32>,
+    ) {
+        Self::cancel_passage(ctx, planned, ball);
+        let poly = &self.layout.polys[(me - self.first_sector()) as usize];
+        if info.pocket.is_none() {
+            let now = ctx.now().clone();
+            if let Some(t) = polygon::departure_time(poly, &info.traj, info.radius, now.t()) {
+                let key = Key::at(t.max(now.t()), DEPARTURE);
+                let time = if VTime::at(key.clone()) > now {
+                    VTime::at(key)
+                } else {
+                    now.next_gen()
+                };
+                let p = Self::passage(ctx, me, ball, false, time, info.clone());
+                planned.push(p);
+            }
+        }
+        for &(b, _) in members {
+            if b != ball && after.is_none_or(|a| b > a) {
+                ctx.send_now(
+                    b,
+                    SecMsg::NewVelocity {
+                        ball,
+                        info: info.clone(),
+                    },
+                );
+            }
+        }
+        for &s in &self.layout.adjacent[(me - self.first_sector()) as usize] {
+            ctx.send_now(
+                self.first_sector() + s,
+                SecMsg::NewVelocity {
+                    ball,
+                    info: info.clone(),
+                },
+            );
+        }
+    }
+
+    fn sector_batch(
+        &self,
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        members: &mut Vec<(u32, Arc<BallInfo>)>,
+        planned: &mut Vec<Passage>,
+        batch: &[Envelope<SecMsg>],
+    ) {
+        let poly = &self.layout.polys[(me - self.first_sector()) as usize];
+        for env in batch {
+            match &env.msg {
+                SecMsg::SectorEntry { ball, .. } => {
+                    let Some(k) = planned.iter().position(|p| p.ball == *ball && p.entry) else {
+                        continue;
+                    };
+                    let info = planned.swap_remove(k).info;
+                    members.push((*ball, info.clone()));
+                    self.relay(ctx, me, members, planned, *ball, &info, None);
+                }
+                SecMsg::SectorDeparture { ball, .. } => {
+                    planned.retain(|p| p.ball != *ball);
+                    members.retain(|m| m.0 != *ball);
+                }
+                SecMsg::VelocityChange { ball, info } => {
+                    match members.iter().position(|m| m.0 == *ball) {
+                        Some(k) => members[k].1 = info.clone(),
+                        None => members.push((*ball, info.clone())),
+                    }
+                    if info.pocket.is_some() {
+                        members.retain(|m| m.0 != *ball);
+                    }
+                    self.relay(ctx, me, members, planned, *ball, info, None);
+                }
+                SecMsg::VelocityInitialization { ball, info } => {
+                    self.relay(ctx, me, members, planned, *ball, info, Some(*ball));
+                }
+                SecMsg::NewVelocity { ball, info } => {
+                    if let Some(k) = members.iter().position(|m| m.0 == *ball) {
+                        // a member: only news (its course changed out of our sight) matters
+                        if info.fixed > members[k].1.fixed {
+                            members[k].1 = info.clone();
+                            if info.pocket.is_some() {
+                                members.retain(|m| m.0 != *ball);
+                            }
+                            self.relay(ctx, me, members, planned, *ball, info, None);
+                        }
+                        continue;
+                    }
+                    if planned
+                        .iter()
+                        .any(|p| p.ball == *ball && p.entry && p.info.fixed == info.fixed)
+                    {
+                        continue; // this entry is planned already
+                    }
+                    Self::cancel_passage(ctx, planned, *ball);
+                    if info.pocket.is_some() {
+                        continue;
+                    }
+                    let now = ctx.now().clone();
+                    let at_now = info.traj.at(now.t());
+                    let time = if polygon::touches(poly, at_now, info.radius) {
+                        Some(now.next_gen())
+                    } else {
+                        polygon::entry_time(poly, &info.traj, info.radius, now.t()).map(|t| {
+                            let key = Key::start(t);
+                            if VTime::at(key.clone()) > now {
+                                VTime::at(key)
+                            } else {
+                                now.next_gen()
+                            }
+                        })
+                    };
+                    if let Some(time) = time {
+                        let p = Self::passage(ctx, me, *ball, true, time, info.clone());
+                        planned.push(p);
+                    }
+                }
+                SecMsg::Collision { .. } | SecMsg::CollisionConfirm { .. } => {
+                    unreachable!("sectors take part in no collision")
+                }
+            }
+        }
+    }
+}
+
+impl Model for Sectored {
+    type Msg = SecMsg;
+    type State = SecState;
+    type Output = Event;
+
+    fn kind_names(&self) -> &'static [&'static str] {
+        &KIND_NAMES
+    }
+
+    fn kind(&self, msg: &SecMsg) -> usize {
+        match msg {
+            SecMsg::NewVelocity { .. } => 0,
+            SecMsg::Collision { .. } => 1,
+            SecMsg::VelocityChange { .. } => 2,
+            SecMsg::SectorEntry { .. } => 3,
+            SecMsg::SectorDeparture { .. } => 4,
+            SecMsg::VelocityInitialization { .. } => 5,
+            SecMsg::CollisionConfirm { .. } => 6,
+        }
+    }
+
+    /// Collisions first (4.3.1), then entries, velocity news, and departures last.
+    fn priority(&self, msg: &SecMsg) -> u8 {
+        match msg {
+            SecMsg::Collision { .. } => 0,
+            SecMsg::CollisionConfirm { .. } => 1,
+            SecMsg::SectorEntry { .. } => 2,
+            SecMsg::VelocityChange { .. } | SecMsg::VelocityInitialization { .. } => 3,
+            SecMsg::NewVelocity { .. } => 4,
+            SecMsg::SectorDeparture { .. } => 5,
+        }
+    }
+
+    /// Thesis 5.4: each ball sends VelocityInitialization to its sectors, which tell only the
+    /// balls after it; fixed objects hear from every ball directly.
+    fn init(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, state: &mut SecState) {
+        if let SecState::Ball { info, sectors, .. } = state {
+            for &s in sectors.iter() {
+                ctx.send_now(
+                    s,
+                    SecMsg::VelocityInitialization {
+                        ball: me,
+                        info: info.clone(),
+                    },
+                );
+            }
+            for f in self.fixed_ids() {
+                ctx.send_now(
+                    f,
+                    SecMsg::NewVelocity {
+                        ball: me,
+                        info: info.clone(),
+                    },
+                );
+            }
+        }
+    }
+
+    fn handle(
+        &self,
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        state: &mut SecState,
+        batch: &[Envelope<SecMsg>],
+    ) {
+        match state {
+            SecState::Ball {
+                info,
+                planned,
+                sectors,
+                awaiting,
+            } => self.ball_batch(ctx, me, info, planned, sectors, awaiting, batch),
+            SecState::Fixed { planned } => self.fixed_batch(ctx, me, planned, batch),
+            SecState::Sector { members, planned } => {
+                self.sector_batch(ctx, me, members, planned, batch)
+            }
+        }
+    }
+}
