@@ -10,11 +10,11 @@ use crate::engine::time_step::{self, TimeStep};
 use crate::engine::{BallState, Event, Frame, Observer, Outcome, RunError, Span, Table, World};
 use crate::model::pool::NvDelay;
 use crate::model::sectored::Layout;
-use crate::polygon::Polygon;
-use crate::scenario::SectorSpec;
 use crate::output::{digest, events_json};
 use crate::physics::kinetic_energy;
+use crate::polygon::Polygon;
 use crate::scenario::Scenario;
+use crate::scenario::SectorSpec;
 use serde_json::{json, Value};
 use std::time::Instant;
 
@@ -252,6 +252,7 @@ fn messages_json(sent: &[(&'static str, u64)]) -> Value {
         "DisplayYourself",
         "ReverseYourself",
         "ReturnToTable",
+        "CollisionConfirm",
     ] {
         m.insert(name.into(), count(name).into());
     }

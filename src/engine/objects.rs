@@ -120,12 +120,7 @@ impl Objects {
 }
 
 /// The end of a run of either model: balls at `until` and the message counts.
-fn outcome<M: Model>(
-    e: &Sequential<M>,
-    table: &Table,
-    until: f64,
-    counts: EventCounts,
-) -> Outcome
+fn outcome<M: Model>(e: &Sequential<M>, table: &Table, until: f64, counts: EventCounts) -> Outcome
 where
     M::State: BallOf,
 {
@@ -176,35 +171,34 @@ fn run_plain(
         let n = exec.model().table().n_balls as usize;
         // A frame is complete when every ball has drawn itself for it.
         let mut frame: Option<Frame> = None;
-        exec
-            .run(until, &mut |model: &Pool, states, out| match out {
-                PoolOutput::Event(ev) => {
-                    counts.add(ev.kind);
-                    let view = View {
-                        table: model.table(),
-                        states,
-                    };
-                    obs.on_event(&ev, &view)
+        exec.run(until, &mut |model: &Pool, states, out| match out {
+            PoolOutput::Event(ev) => {
+                counts.add(ev.kind);
+                let view = View {
+                    table: model.table(),
+                    states,
+                };
+                obs.on_event(&ev, &view)
+            }
+            PoolOutput::Draw { t, ball, state } => {
+                let f = frame.get_or_insert_with(|| Frame {
+                    t,
+                    balls: Vec::with_capacity(n),
+                });
+                debug_assert_eq!(f.balls.len(), ball as usize, "balls draw in order");
+                f.balls.push(BallState {
+                    traj: state.traj,
+                    radius: state.radius,
+                    mass: state.mass,
+                    pocket: state.pocket,
+                });
+                if f.balls.len() == n {
+                    let done = frame.take().expect("a frame is being drawn");
+                    obs.on_frame(&done, model.table())?;
                 }
-                PoolOutput::Draw { t, ball, state } => {
-                    let f = frame.get_or_insert_with(|| Frame {
-                        t,
-                        balls: Vec::with_capacity(n),
-                    });
-                    debug_assert_eq!(f.balls.len(), ball as usize, "balls draw in order");
-                    f.balls.push(BallState {
-                        traj: state.traj,
-                        radius: state.radius,
-                        mass: state.mass,
-                        pocket: state.pocket,
-                    });
-                    if f.balls.len() == n {
-                        let done = frame.take().expect("a frame is being drawn");
-                        obs.on_frame(&done, model.table())?;
-                    }
-                    Ok(())
-                }
-            })?;
+                Ok(())
+            }
+        })?;
         Ok(outcome(exec, exec.model().table(), until, counts))
     }
 }

@@ -541,16 +541,8 @@ impl Sectored {
                     let contact = self.table.contact(me, &x.traj, x.radius);
                     if let Some(key) = Self::key_of(contact, &x.fixed, pair(*ball, me)) {
                         let none = Key::start(f64::NEG_INFINITY);
-                        let p = Self::schedule(
-                            ctx,
-                            me,
-                            *ball,
-                            key,
-                            None,
-                            none,
-                            None,
-                            x.fixed.clone(),
-                        );
+                        let p =
+                            Self::schedule(ctx, me, *ball, key, None, none, None, x.fixed.clone());
                         planned.push(p);
                     }
                 }
