@@ -114,9 +114,48 @@ enum Command {
     Bench(poolsim::bench::BenchArgs),
     /// Run PHOLD, the standard PDES benchmark, and report committed events per second.
     Phold(PholdArgs),
+    /// The analytic model of message counts (thesis ch. 7): F(s) and the best sector size.
+    Model(ModelArgs),
     /// Run from -Q to 0, reverse every ball, run on to Q, and report how far the balls end from
     /// where they started (thesis 4.6-4.7).
     Reverse(Box<ReverseArgs>),
+}
+
+/// Arguments of `poolsim model`.
+#[derive(clap::Args, Clone, Debug)]
+struct ModelArgs {
+    /// Number of balls N on the unit-square table.
+    #[arg(long, allow_negative_numbers = true)]
+    balls: f64,
+    /// Ball speed V.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    speed: f64,
+    /// Duration T.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    time: f64,
+    /// Number of velocity changes m (0: equation 1; otherwise equation 2).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    changes: f64,
+    /// Print one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+fn model(a: &ModelArgs) -> Result<(), Failure> {
+    use poolsim::analytic::{report, report_json, ModelParams};
+    let p = ModelParams {
+        balls: a.balls,
+        speed: a.speed,
+        time: a.time,
+        changes: a.changes,
+    };
+    p.validate().map_err(usage)?;
+    if a.json {
+        println!("{}", report_json(&p));
+    } else {
+        print!("{}", report(&p));
+    }
+    Ok(())
 }
 
 /// Arguments of `poolsim reverse`.
@@ -626,6 +665,7 @@ fn main() -> ExitCode {
         Command::Bench(b) => poolsim::bench::run(b).map_err(usage),
         Command::Phold(a) => phold(a),
         Command::Reverse(a) => reverse(a),
+        Command::Model(a) => model(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

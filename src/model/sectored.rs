@@ -34,13 +34,86 @@ use crate::scenario::Scenario;
 use crate::vtime::{pair, Key, DEPARTURE};
 use std::sync::Arc;
 
-/// The sectors of a table: their polygons and which touch which.
+/// The sectors of a table: their polygons, which touch which, and a bucket index of their boxes
+/// so that finding the sectors a disk touches costs O(1), not O(sectors).
 #[derive(Clone, Debug)]
 pub struct Layout {
     /// The sectors, `Sector-1` first.
     pub polys: Vec<Polygon>,
     /// For each sector, the sectors whose boundaries meet its own (an edge or a corner).
     pub adjacent: Vec<Vec<u32>>,
+    index: BoxIndex,
+}
+
+/// Sectors bucketed by bounding box on a uniform grid over the table.
+#[derive(Clone, Debug)]
+struct BoxIndex {
+    lo: Vec2,
+    cell: Vec2,
+    nx: usize,
+    ny: usize,
+    buckets: Vec<Vec<u32>>,
+}
+
+impl BoxIndex {
+    fn new(polys: &[Polygon], lo: Vec2, hi: Vec2) -> BoxIndex {
+        let n = (polys.len() as f64).sqrt().ceil().max(1.0) as usize;
+        let span = hi - lo;
+        let cell = Vec2::new(span.x / n as f64, span.y / n as f64);
+        let mut index = BoxIndex {
+            lo,
+            cell,
+            nx: n,
+            ny: n,
+            buckets: vec![Vec::new(); n * n],
+        };
+        for (k, p) in polys.iter().enumerate() {
+            let (a, b) = p.bounds();
+            index.for_buckets(a, b, |bucket| bucket.push(k as u32));
+        }
+        index
+    }
+
+    fn range(&self, a: f64, lo: f64, cell: f64, n: usize) -> usize {
+        (((a - lo) / cell).floor().max(0.0) as usize).min(n - 1)
+    }
+
+    fn for_buckets(&mut self, a: Vec2, b: Vec2, mut f: impl FnMut(&mut Vec<u32>)) {
+        let (x0, x1) = (
+            self.range(a.x, self.lo.x, self.cell.x, self.nx),
+            self.range(b.x, self.lo.x, self.cell.x, self.nx),
+        );
+        let (y0, y1) = (
+            self.range(a.y, self.lo.y, self.cell.y, self.ny),
+            self.range(b.y, self.lo.y, self.cell.y, self.ny),
+        );
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                f(&mut self.buckets[y * self.nx + x]);
+            }
+        }
+    }
+
+    /// Sectors whose boxes may meet the box `[a, b]`, each once, ascending.
+    fn candidates(&self, a: Vec2, b: Vec2) -> Vec<u32> {
+        let (x0, x1) = (
+            self.range(a.x, self.lo.x, self.cell.x, self.nx),
+            self.range(b.x, self.lo.x, self.cell.x, self.nx),
+        );
+        let (y0, y1) = (
+            self.range(a.y, self.lo.y, self.cell.y, self.ny),
+            self.range(b.y, self.lo.y, self.cell.y, self.ny),
+        );
+        let mut out: Vec<u32> = Vec::new();
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                out.extend_from_slice(&self.buckets[y * self.nx + x]);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
 }
 
 impl Layout {
@@ -49,7 +122,12 @@ impl Layout {
         polygon::validate_layout(&polys, table.lo, table.hi)?;
         let size = (table.hi - table.lo).norm();
         let adjacent = polygon::adjacency(&polys, 1e-9 * size);
-        Ok(Layout { polys, adjacent })
+        let index = BoxIndex::new(&polys, table.lo, table.hi);
+        Ok(Layout {
+            polys,
+            adjacent,
+            index,
+        })
     }
 
     /// An `nx` × `ny` grid over the table's box.
@@ -70,7 +148,10 @@ impl Layout {
 
     /// The sectors a disk at `centre` with radius `r` touches.
     pub fn touching(&self, centre: Vec2, r: f64) -> Vec<u32> {
-        (0..self.polys.len() as u32)
+        let d = Vec2::new(r, r);
+        self.index
+            .candidates(centre - d, centre + d)
+            .into_iter()
             .filter(|&k| polygon::touches(&self.polys[k as usize], centre, r))
             .collect()
     }
