@@ -39,6 +39,13 @@ pub struct BenchArgs {
         default_value = "36,144,576"
     )]
     pub objects_balls: Vec<usize>,
+    /// Ball counts for the sectored objects engine (`--sectors auto`, area fraction 0.3).
+    #[arg(
+        long = "sectored-balls",
+        value_delimiter = ',',
+        default_value = "1024,4096"
+    )]
+    pub sectored_balls: Vec<usize>,
     /// PHOLD objects (16 messages each, remote 0.1, 2 partitions, lookahead 0.1).
     #[arg(long = "phold-objects", default_value_t = 1024)]
     pub phold_objects: u32,
@@ -192,7 +199,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     }
     let mut objects = Vec::new();
     for &n in &a.objects_balls {
-        let r = measure_objects(n)?;
+        let r = measure_objects(n, None)?;
         if !a.json {
             println!(
                 "{:>9} {:>11} {:>12} {:>9.3} {:>14.0} {:>12.0} {:>10.1}",
@@ -206,6 +213,31 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             );
         }
         objects.push(r);
+    }
+    if !a.json {
+        println!();
+        println!("sectored objects engine (thesis fig. 14, --sectors auto), gas at area fraction 0.3, until 1");
+        println!(
+            "{:>9} {:>11} {:>12} {:>9} {:>14} {:>12} {:>10}",
+            "balls", "events", "messages", "wall s", "events/s", "messages/s", "msgs/event"
+        );
+    }
+    let mut sectored = Vec::new();
+    for &n in &a.sectored_balls {
+        let r = measure_objects(n, Some(crate::run::SectorChoice::Auto))?;
+        if !a.json {
+            println!(
+                "{:>9} {:>11} {:>12} {:>9.3} {:>14.0} {:>12.0} {:>10.1}",
+                r.balls,
+                r.events,
+                r.messages,
+                r.seconds,
+                r.events as f64 / r.seconds,
+                r.messages as f64 / r.seconds,
+                r.messages as f64 / r.events.max(1) as f64
+            );
+        }
+        sectored.push(r);
     }
     let phold = crate::model::phold::run_sequential(
         crate::model::phold::PholdConfig {
@@ -223,7 +255,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         println!(
             "{}",
             json!({"machine": m, "engine": "event-list", "rows": rows,
-                   "objects": objects, "phold": phold})
+                   "objects": objects, "sectored": sectored, "phold": phold})
         );
     } else {
         println!();
@@ -249,17 +281,36 @@ pub struct ObjectsRow {
     pub seconds: f64,
 }
 
-/// Runs the thesis gas (seed 1, until 4) on the objects engine.
-pub fn measure_objects(balls: usize) -> Result<ObjectsRow, String> {
+/// Runs the thesis gas (seed 1) on the objects engine: plain (thesis table, until 4), or
+/// sectored (area fraction 0.3, until 1).
+pub fn measure_objects(
+    balls: usize,
+    sectors: Option<crate::run::SectorChoice>,
+) -> Result<ObjectsRow, String> {
     let k = ((balls as f64).sqrt().round() as usize).max(1);
     let params = Params {
         balls: Some(k * k),
         seed: Some(1),
+        area_fraction: sectors.map(|_| 0.3),
         ..Params::default()
     };
-    let scenario =
+    let mut scenario =
         builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
     let start = Instant::now();
+    if let Some(choice) = sectors {
+        scenario.until = 1.0;
+        let layout = crate::run::sector_layout(&scenario, choice)?;
+        let mut engine = crate::engine::objects::Objects::sectored(&scenario, layout);
+        let out = engine
+            .run(scenario.until, &mut Ignore)
+            .map_err(|e| e.to_string())?;
+        return Ok(ObjectsRow {
+            balls: k * k,
+            events: out.events.total(),
+            messages: out.messages.iter().map(|(_, c)| c).sum(),
+            seconds: start.elapsed().as_secs_f64(),
+        });
+    }
     let mut engine = crate::engine::objects::Objects::new(
         &scenario,
         crate::model::pool::NvDelay::Exact,
