@@ -1,0 +1,164 @@
+//! The command line of the objects engines, reversal, the model and PHOLD, end to end.
+
+use std::io::Write;
+use std::process::{Command, Output};
+
+fn poolsim(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_poolsim"))
+        .args(args)
+        .output()
+        .expect("poolsim runs")
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
+}
+
+/// Exit status 2 and exactly one line on stderr that mentions `needle`.
+fn bad(args: &[&str], needle: &str) {
+    let out = poolsim(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    assert!(err.contains(needle), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
+
+#[test]
+fn objects_engine_reports_messages_by_type() {
+    let d = json(&poolsim(&[
+        "run",
+        "gas",
+        "--balls",
+        "36",
+        "--engine",
+        "objects",
+        "--sectors",
+        "none",
+        "--json",
+    ]));
+    let m = &d["messages"];
+    for k in ["NewVelocity", "Collision", "Cancel"] {
+        assert!(m[k].as_u64().unwrap() > 0, "{k}: {m}");
+    }
+    for k in ["VelocityChange", "SectorEntry", "SectorDeparture"] {
+        assert_eq!(m[k].as_u64().unwrap(), 0, "{k}: {m}");
+    }
+    assert_eq!(d["engine"], "objects");
+    let plain = json(&poolsim(&["run", "gas", "--balls", "36", "--json"]));
+    assert_eq!(d["final_state_digest"], plain["final_state_digest"]);
+}
+
+#[test]
+fn sectored_engine_reports_sector_messages_and_the_same_state() {
+    let plain = json(&poolsim(&["run", "gas", "--json"]));
+    for sectors in ["1", "3", "2x5", "auto"] {
+        let d = json(&poolsim(&[
+            "run",
+            "gas",
+            "--engine",
+            "objects",
+            "--sectors",
+            sectors,
+            "--check",
+            "--json",
+        ]));
+        let m = &d["messages"];
+        assert!(m["VelocityChange"].as_u64().unwrap() > 0, "{sectors}: {m}");
+        assert!(
+            m["VelocityInitialization"].as_u64().unwrap() >= 36,
+            "one per ball and sector it touches"
+        );
+        assert_eq!(
+            d["final_state_digest"], plain["final_state_digest"],
+            "{sectors}"
+        );
+    }
+}
+
+#[test]
+fn bad_sector_layouts_are_refused() {
+    bad(
+        &["run", "gas", "--engine", "objects", "--sectors", "0"],
+        "--sectors",
+    );
+    bad(
+        &["run", "gas", "--engine", "objects", "--sectors", "3y4"],
+        "--sectors",
+    );
+    bad(
+        &[
+            "run",
+            "gas",
+            "--engine",
+            "objects",
+            "--sectors",
+            "3",
+            "--newvelocity-delay",
+            "0.1",
+        ],
+        "--newvelocity-delay",
+    );
+    bad(&["run", "gas", "--sectors", "3"], "--sectors");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("overlap.toml");
+    let mut f = std::fs::File::create(&path).unwrap();
+    writeln!(
+        f,
+        "[[ball]]\nposition = [50.0, 50.0]\nradius = 5.0\n\
+         [[cushion]]\nfrom = [0.0, 0.0]\nto = [0.0, 100.0]\n\
+         [[cushion]]\nfrom = [0.0, 100.0]\nto = [100.0, 100.0]\n\
+         [[cushion]]\nfrom = [100.0, 100.0]\nto = [100.0, 0.0]\n\
+         [[cushion]]\nfrom = [100.0, 0.0]\nto = [0.0, 0.0]\n\
+         [[sectors.polygon]]\npoints = [[0.0, 0.0], [60.0, 0.0], [60.0, 100.0], [0.0, 100.0]]\n\
+         [[sectors.polygon]]\npoints = [[50.0, 0.0], [100.0, 0.0], [100.0, 100.0], [50.0, 100.0]]"
+    )
+    .unwrap();
+    drop(f);
+    bad(
+        &["run", path.to_str().unwrap(), "--engine", "objects"],
+        "sectors.polygon[1] overlaps sectors.polygon[2]",
+    );
+}
+
+#[test]
+fn reverse_model_and_phold() {
+    let r = json(&poolsim(&[
+        "reverse", "reversal", "--quit", "3", "--seed", "3", "--engine", "objects", "--json",
+    ]));
+    assert!(r["events"].as_u64().unwrap() > 100);
+    assert!(r["max_position_error"].as_f64().unwrap() < 1e-6);
+    bad(&["reverse", "reversal", "--quit", "-1"], "--quit");
+    let m = json(&poolsim(&["model", "--balls", "64", "--json"]));
+    let s = m["optimal"]["sector_width"].as_f64().unwrap();
+    assert!((s - 8f64.sqrt() / 8.0).abs() < 1e-12, "{m}");
+    bad(&["model", "--balls", "-3"], "--balls");
+    let p = json(&poolsim(&[
+        "phold",
+        "--objects",
+        "64",
+        "--events-per-object",
+        "2",
+        "--end",
+        "5",
+        "--json",
+    ]));
+    assert!(p["committed"].as_u64().unwrap() > 0);
+    let again = json(&poolsim(&[
+        "phold",
+        "--objects",
+        "64",
+        "--events-per-object",
+        "2",
+        "--end",
+        "5",
+        "--json",
+    ]));
+    assert_eq!(p["committed"], again["committed"]);
+    bad(&["phold", "--remote", "1.5"], "--remote");
+}
