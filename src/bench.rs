@@ -192,50 +192,29 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     if !a.json {
         println!();
         println!("objects engine (thesis fig. 3, sequential, non-sectored), thesis gas until 4");
-        println!(
-            "{:>9} {:>11} {:>12} {:>9} {:>14} {:>12} {:>10}",
-            "balls", "events", "messages", "wall s", "events/s", "messages/s", "msgs/event"
-        );
+        ObjectsRow::print_header();
     }
     let mut objects = Vec::new();
     for &n in &a.objects_balls {
         let r = measure_objects(n, None)?;
         if !a.json {
-            println!(
-                "{:>9} {:>11} {:>12} {:>9.3} {:>14.0} {:>12.0} {:>10.1}",
-                r.balls,
-                r.events,
-                r.messages,
-                r.seconds,
-                r.events as f64 / r.seconds,
-                r.messages as f64 / r.seconds,
-                r.messages as f64 / r.events.max(1) as f64
-            );
+            r.print();
         }
         objects.push(r);
     }
     if !a.json {
         println!();
-        println!("sectored objects engine (thesis fig. 14, --sectors auto), gas at area fraction 0.3, until 1");
         println!(
-            "{:>9} {:>11} {:>12} {:>9} {:>14} {:>12} {:>10}",
-            "balls", "events", "messages", "wall s", "events/s", "messages/s", "msgs/event"
+            "sectored objects engine (thesis fig. 14, --sectors auto), gas at area fraction 0.3, \
+             until 1"
         );
+        ObjectsRow::print_header();
     }
     let mut sectored = Vec::new();
     for &n in &a.sectored_balls {
         let r = measure_objects(n, Some(crate::run::SectorChoice::Auto))?;
         if !a.json {
-            println!(
-                "{:>9} {:>11} {:>12} {:>9.3} {:>14.0} {:>12.0} {:>10.1}",
-                r.balls,
-                r.events,
-                r.messages,
-                r.seconds,
-                r.events as f64 / r.seconds,
-                r.messages as f64 / r.seconds,
-                r.messages as f64 / r.events.max(1) as f64
-            );
+            r.print();
         }
         sectored.push(r);
     }
@@ -279,6 +258,29 @@ pub struct ObjectsRow {
     pub messages: u64,
     /// Wall seconds, setup included.
     pub seconds: f64,
+}
+
+impl ObjectsRow {
+    fn print_header() {
+        println!(
+            "{:>9} {:>11} {:>12} {:>9} {:>14} {:>12} {:>10}",
+            "balls", "events", "messages", "wall s", "events/s", "messages/s", "msgs/event"
+        );
+    }
+
+    fn print(&self) {
+        let r = self;
+        println!(
+            "{:>9} {:>11} {:>12} {:>9.3} {:>14.0} {:>12.0} {:>10.1}",
+            r.balls,
+            r.events,
+            r.messages,
+            r.seconds,
+            r.events as f64 / r.seconds,
+            r.messages as f64 / r.seconds,
+            r.messages as f64 / r.events.max(1) as f64
+        );
+    }
 }
 
 /// Runs the thesis gas (seed 1) on the objects engine: plain (thesis table, until 4), or

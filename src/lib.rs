@@ -15,6 +15,7 @@ pub mod analytic;
 pub mod bench;
 pub mod check;
 pub mod engine;
+pub mod experiment;
 pub mod geometry;
 pub mod kernel;
 pub mod model;

@@ -339,6 +339,19 @@ impl Sectored {
         self.table.n_balls..self.first_sector()
     }
 
+    /// Tells every fixed object ball `me`'s trajectory.
+    fn tell_fixed(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, info: &Arc<BallInfo>) {
+        for f in self.fixed_ids() {
+            ctx.send_now(
+                f,
+                SecMsg::NewVelocity {
+                    ball: me,
+                    info: info.clone(),
+                },
+            );
+        }
+    }
+
     /// Schedules a collision of `me` with `partner` at `key`.
     #[allow(clippy::too_many_arguments)]
     fn schedule(
@@ -508,15 +521,7 @@ impl Sectored {
                     },
                 );
             }
-            for f in self.fixed_ids() {
-                ctx.send_now(
-                    f,
-                    SecMsg::NewVelocity {
-                        ball: me,
-                        info: info.clone(),
-                    },
-                );
-            }
+            self.tell_fixed(ctx, me, info);
             if info.pocket.is_some() {
                 sectors.clear();
             }
@@ -847,15 +852,7 @@ impl Model for Sectored {
                     },
                 );
             }
-            for f in self.fixed_ids() {
-                ctx.send_now(
-                    f,
-                    SecMsg::NewVelocity {
-                        ball: me,
-                        info: info.clone(),
-                    },
-                );
-            }
+            self.tell_fixed(ctx, me, info);
         }
     }
 

@@ -1,0 +1,514 @@
+//! Graphics (thesis 4.2 and its plates): frames of a run drawn as the thesis drew them, written
+//! as SVG, PNG, an animated GIF, or one self-contained HTML page with a player.
+//!
+//! ```text
+//!  Scenario ──► engine (execute, frame time F) ──► Recorder ──► Recording ──┬─► svg::frame ──► .svg
+//!                  │ on_frame, on_event                                      ├─► raster     ──► .png, .gif
+//!  objects engines ┴─► run again in chunks up to each frame: message counts  └─► html::page ──► .html
+//! ```
+//!
+//! A frame shows the table after every event up to and including its time (thesis 4.3.1): the
+//! title `POOL SIMULATION AT t`, the cushions, the pockets with the names of the balls they hold
+//! listed under their labels, the corners, every ball on the table with its name and its velocity
+//! vector (a line from the centre to where the ball will be one time unit later; none for a ball
+//! at rest), and, on a sectored table, the sectors with their names and the balls inside them
+//! (plate 7; a ball then lists the sectors it touches under its name). The drawing depends on the
+//! frame only, never on the engine that made it.
+//!
+//! Besides frames, a recording keeps the run's history (every ball's trajectory pieces and the
+//! events, up to a size cap), so the HTML player can show the exact state at any time, and, for
+//! the objects engines, the messages sent up to each frame time: the engine is run a second time,
+//! stopping at every frame time to read its message statistics.
+
+pub mod html;
+pub mod raster;
+pub mod svg;
+
+use crate::engine::objects::Objects;
+use crate::engine::{
+    BallState, Event, EventCounts, Frame, Ignore, Observer, RunError, Span, Table, World,
+};
+use crate::geometry::Vec2;
+use crate::kernel::Model;
+use crate::model::sectored::Layout;
+use crate::run::{execute, sector_layout, EngineKind, RunConfig, SectorChoice};
+use crate::scenario::Scenario;
+use serde_json::Value;
+
+/// The most frames one recording may hold.
+pub const MAX_FRAMES: usize = 20_000;
+
+/// The most ball positions (frames × balls) one recording may hold.
+pub const MAX_FRAME_BALLS: usize = 20_000_000;
+
+/// The most trajectory pieces a recording keeps as its history; past this the HTML player
+/// interpolates between frames instead.
+pub const MAX_HISTORY: usize = 1_000_000;
+
+/// The message types whose sum is the thesis' total (table 5).
+pub const THESIS_MESSAGES: [&str; 6] = [
+    "VelocityChange",
+    "NewVelocity",
+    "SectorDeparture",
+    "SectorEntry",
+    "Cancel",
+    "Collision",
+];
+
+/// What to draw and how to run: the engine, the end time and the frame time.
+#[derive(Clone, Debug)]
+pub struct RenderConfig {
+    /// The engine that makes the frames.
+    pub engine: EngineKind,
+    /// End time; frames are drawn at `0, F, 2F, …` up to it.
+    pub until: f64,
+    /// Time between frames, `F` (positive).
+    pub frame_time: f64,
+    /// Check invariants at every event while running.
+    pub check: bool,
+    /// The sectors to draw (none when `None`); a sectored engine draws its own layout whatever
+    /// this says, unless it is `None`.
+    pub sectors: Option<SectorChoice>,
+}
+
+/// The fixed part of every frame: the table, the balls' names and sizes, the sectors.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The scenario's name.
+    pub name: String,
+    /// The table: cushions, pockets, corners and the numbering of objects.
+    pub table: Table,
+    /// The sectors drawn, if any.
+    pub sectors: Option<Layout>,
+}
+
+impl Scene {
+    /// The scene of a scenario, with the sector layout `sectors` (or none).
+    pub fn new(scenario: &Scenario, sectors: Option<Layout>) -> Scene {
+        Scene {
+            name: scenario.name.clone(),
+            table: Table::new(scenario),
+            sectors,
+        }
+    }
+
+    /// `Sector-{k+1}`.
+    pub fn sector_name(k: usize) -> String {
+        format!("Sector-{}", k + 1)
+    }
+}
+
+/// One frame with what had happened by its time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shot {
+    /// The frame: every ball fixed at its time.
+    pub frame: Frame,
+    /// Physical events executed up to and including the frame's time.
+    pub events: EventCounts,
+    /// Messages sent by every batch up to and including the frame's time, by thesis type
+    /// (objects engines only; the event-list engine sends none).
+    pub messages: Option<Vec<(&'static str, u64)>>,
+}
+
+/// One piece of a ball's path: from time `from` on, the ball is in `state` (until its next
+/// piece).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Piece {
+    /// The time of the event that put the ball in this state.
+    pub from: f64,
+    /// The ball's state from then on.
+    pub state: BallState,
+}
+
+/// The whole run: every ball's path as pieces, and every physical event in execution order.
+#[derive(Clone, Debug, Default)]
+pub struct History {
+    /// For each ball, its pieces in time order; the first starts at time 0.
+    pub pieces: Vec<Vec<Piece>>,
+    /// Every executed physical event.
+    pub events: Vec<Event>,
+}
+
+impl History {
+    /// Ball `i`'s state at time `t`, after every event up to and including `t`.
+    pub fn state_at(&self, i: usize, t: f64) -> BallState {
+        let path = &self.pieces[i];
+        let k = path.partition_point(|p| p.from <= t).max(1) - 1;
+        fix_at(path[k].state, t)
+    }
+
+    /// The frame at time `t` (the same as an engine's frame at `t`).
+    pub fn frame_at(&self, t: f64) -> Frame {
+        Frame {
+            t,
+            balls: (0..self.pieces.len()).map(|i| self.state_at(i, t)).collect(),
+        }
+    }
+
+    /// The number of pieces over all balls.
+    pub fn len(&self) -> usize {
+        self.pieces.iter().map(Vec::len).sum()
+    }
+
+    /// Whether there is no piece at all (no balls).
+    pub fn is_empty(&self) -> bool {
+        self.pieces.iter().all(Vec::is_empty)
+    }
+}
+
+/// A ball's state fixed at time `t`: on its trajectory, or as it is in its pocket.
+pub fn fix_at(mut b: BallState, t: f64) -> BallState {
+    if b.pocket.is_none() {
+        b.traj.position = b.traj.at(t);
+        b.traj.t0 = t;
+    }
+    b
+}
+
+/// Everything drawn from one run.
+#[derive(Clone, Debug)]
+pub struct Recording {
+    /// The fixed part of every frame.
+    pub scene: Scene,
+    /// The engine's name (`event-list`, `objects`, …).
+    pub engine: &'static str,
+    /// End time.
+    pub until: f64,
+    /// Time between frames.
+    pub frame_time: f64,
+    /// The frames, at `0, F, 2F, …`.
+    pub shots: Vec<Shot>,
+    /// The exact history, unless it was longer than [`MAX_HISTORY`] pieces.
+    pub history: Option<History>,
+    /// The run summary (as `poolsim run --json` prints it).
+    pub summary: Value,
+}
+
+/// Records what a run shows: frames with the event counts at their times, and the history.
+struct Recorder {
+    counts: EventCounts,
+    frames: Vec<(Frame, EventCounts)>,
+    history: Option<History>,
+    pieces: usize,
+}
+
+impl Recorder {
+    fn new(initial: &[BallState]) -> Recorder {
+        Recorder {
+            counts: EventCounts::default(),
+            frames: Vec::new(),
+            history: Some(History {
+                pieces: initial
+                    .iter()
+                    .map(|b| {
+                        vec![Piece {
+                            from: b.traj.t0,
+                            state: *b,
+                        }]
+                    })
+                    .collect(),
+                events: Vec::new(),
+            }),
+            pieces: initial.len(),
+        }
+    }
+}
+
+impl Observer for Recorder {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
+        self.counts.add(ev.kind);
+        let n = world.n_balls() as u32;
+        if let Some(h) = &mut self.history {
+            for i in [ev.a, ev.b].into_iter().filter(|&i| i < n) {
+                h.pieces[i as usize].push(Piece {
+                    from: ev.t,
+                    state: world.ball(i),
+                });
+                self.pieces += 1;
+            }
+            h.events.push(*ev);
+            if self.pieces > MAX_HISTORY {
+                self.history = None;
+            }
+        }
+        Ok(())
+    }
+
+    fn on_frame(&mut self, frame: &Frame, _: &Table) -> Result<(), RunError> {
+        self.frames.push((frame.clone(), self.counts));
+        Ok(())
+    }
+}
+
+/// The times of the frames: `0, F, 2F, …` up to `until`, as the engines compute them.
+pub fn frame_times(until: f64, frame_time: f64) -> Vec<f64> {
+    let span = Span {
+        frame_time: Some(frame_time),
+        ..Span::default()
+    };
+    (0u64..)
+        .map_while(|k| span.frame(k).filter(|&t| t <= until))
+        .collect()
+}
+
+/// Checks a frame time and end time, and the size of the recording they would make.
+fn check_sizes(balls: usize, cfg: &RenderConfig) -> Result<(), RunError> {
+    let f = cfg.frame_time;
+    if !(f.is_finite() && f > 0.0) {
+        return Err(RunError::Input(format!(
+            "--frame-time: must be a positive number, got {f}"
+        )));
+    }
+    let u = cfg.until;
+    if !(u.is_finite() && u >= 0.0) {
+        return Err(RunError::Input(format!(
+            "--until: must be a finite number not below 0, got {u}"
+        )));
+    }
+    let frames = (u / f).floor() + 1.0;
+    if frames > MAX_FRAMES as f64 || frames * balls as f64 > MAX_FRAME_BALLS as f64 {
+        return Err(RunError::Input(format!(
+            "--frame-time: {f} up to {u} makes {frames} frames of {balls} balls, more than the \
+             {MAX_FRAMES} frames or {MAX_FRAME_BALLS} ball positions one recording holds; use a \
+             larger frame time"
+        )));
+    }
+    Ok(())
+}
+
+/// The messages an objects engine has sent so far, by thesis type, `Cancel` included.
+fn messages_of(e: &Objects) -> Vec<(&'static str, u64)> {
+    let names = match e {
+        Objects::Plain(x) => x.model().kind_names(),
+        Objects::Sectored(x) => x.model().kind_names(),
+    };
+    let stats = e.stats();
+    let mut out: Vec<(&'static str, u64)> = names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| (*n, stats.get(k)))
+        .collect();
+    out.push(("Cancel", stats.cancels));
+    out
+}
+
+/// Runs an objects engine again, stopping at every frame time: the frames and the messages sent
+/// up to each. `None` for engines that send no messages.
+#[allow(clippy::type_complexity)]
+fn chunked(
+    scenario: &Scenario,
+    engine: EngineKind,
+    times: &[f64],
+) -> Result<Option<Vec<(Frame, EventCounts, Vec<(&'static str, u64)>)>>, RunError> {
+    let mut e = match engine {
+        EngineKind::Objects { delay } => Objects::new(scenario, delay, Span::default()),
+        EngineKind::Sectored { sectors } => {
+            let layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
+            Objects::sectored(scenario, layout)
+        }
+        EngineKind::EventList | EngineKind::TimeStep { .. } => return Ok(None),
+    };
+    let mut counts = EventCounts::default();
+    let mut out = Vec::with_capacity(times.len());
+    for &t in times {
+        let o = e.run(t, &mut Ignore)?;
+        for (c, k) in counts.by_kind.iter_mut().zip(o.events.by_kind) {
+            *c += k;
+        }
+        out.push((
+            Frame {
+                t,
+                balls: o.balls.iter().map(|b| fix_at(*b, t)).collect(),
+            },
+            counts,
+            messages_of(&e),
+        ));
+    }
+    Ok(Some(out))
+}
+
+/// Runs `scenario` as `cfg` says and records every frame, the history and the summary.
+///
+/// The event-list and plain objects engines draw their own frames (the Projector's
+/// DisplayYourself, thesis 4.2); the sectored objects engine's frames are its state when it is
+/// stopped at each frame time.
+pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunError> {
+    check_sizes(scenario.balls.len(), cfg)?;
+    let times = frame_times(cfg.until, cfg.frame_time);
+    let drawn = match (cfg.sectors, cfg.engine) {
+        (None, _) => None,
+        (Some(_), EngineKind::Sectored { sectors }) | (Some(sectors), _) => {
+            Some(sector_layout(scenario, sectors).map_err(RunError::Input)?)
+        }
+    };
+    let sectored = matches!(cfg.engine, EngineKind::Sectored { .. });
+    let mut rec = Recorder::new(&BallState::initial(scenario, 0.0));
+    let run = RunConfig {
+        engine: cfg.engine,
+        until: cfg.until,
+        check: cfg.check,
+        span: Span {
+            frame_time: (!sectored).then_some(cfg.frame_time),
+            ..Span::default()
+        },
+    };
+    let report = execute(scenario, &run, &mut rec)?;
+    let chunks = chunked(scenario, cfg.engine, &times)?;
+    let shots: Vec<Shot> = match chunks {
+        Some(chunks) if sectored => chunks
+            .into_iter()
+            .map(|(frame, events, messages)| Shot {
+                frame,
+                events,
+                messages: Some(messages),
+            })
+            .collect(),
+        chunks => {
+            let mut messages = chunks.map(|c| c.into_iter().map(|(_, _, m)| m));
+            rec.frames
+                .drain(..)
+                .map(|(frame, events)| Shot {
+                    frame,
+                    events,
+                    messages: messages.as_mut().and_then(Iterator::next),
+                })
+                .collect()
+        }
+    };
+    if shots.len() != times.len() {
+        return Err(RunError::Output(format!(
+            "the engine drew {} frames where {} were due",
+            shots.len(),
+            times.len()
+        )));
+    }
+    Ok(Recording {
+        scene: Scene::new(scenario, drawn),
+        engine: cfg.engine.name(),
+        until: cfg.until,
+        frame_time: cfg.frame_time,
+        shots,
+        history: rec.history,
+        summary: report.summary,
+    })
+}
+
+/// A frame time for a run to `until` when none is given: about 40 frames, rounded to 1, 2 or 5
+/// times a power of ten (0.1 for the thesis' runs to 3 or 4).
+pub fn default_frame_time(until: f64) -> f64 {
+    if !(until.is_finite() && until > 0.0) {
+        return 1.0;
+    }
+    let raw = until / 40.0;
+    let decade = 10f64.powf(raw.log10().floor());
+    let best = [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .min_by(|a, b| {
+            let da = (a.ln() - raw.ln()).abs();
+            let db = (b.ln() - raw.ln()).abs();
+            da.total_cmp(&db)
+        })
+        .unwrap_or(raw);
+    // 0.1 and not 0.10000000000000002
+    let digits = (-best.log10().floor()).max(0.0) as i32 + 1;
+    let p = 10f64.powi(digits);
+    (best * p).round() / p
+}
+
+/// A time as the title shows it: one decimal like the thesis' `0.0` and `1.0` where that is
+/// exact to 1e-9, else as few decimals as show it to that precision.
+pub fn format_time(t: f64) -> String {
+    let t = if t == 0.0 { 0.0 } else { t }; // no "-0.0"
+    for digits in 1..=9 {
+        let p = 10f64.powi(digits);
+        if ((t * p).round() / p - t).abs() <= 1e-9 * t.abs().max(1.0) {
+            return format!("{t:.*}", digits as usize);
+        }
+    }
+    format!("{t}")
+}
+
+/// The sectors (0-based) a ball on the table touches in `scene`, ascending; none for a pocketed
+/// ball or an unsectored scene.
+pub fn sectors_of(scene: &Scene, b: &BallState) -> Vec<u32> {
+    match (&scene.sectors, b.pocket) {
+        (Some(layout), None) => layout.touching(b.traj.position, b.radius),
+        _ => Vec::new(),
+    }
+}
+
+/// The area centroid of a polygon (its vertex mean if the area is zero).
+pub fn centroid(points: &[Vec2]) -> Vec2 {
+    let n = points.len();
+    let (mut a, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    for k in 0..n {
+        let (p, q) = (points[k], points[(k + 1) % n]);
+        let c = p.cross(q);
+        a += c;
+        cx += (p.x + q.x) * c;
+        cy += (p.y + q.y) * c;
+    }
+    if a.abs() > 0.0 {
+        Vec2::new(cx / (3.0 * a), cy / (3.0 * a))
+    } else {
+        let s = points.iter().fold(Vec2::ZERO, |s, p| s + *p);
+        Vec2::new(s.x / n.max(1) as f64, s.y / n.max(1) as f64)
+    }
+}
+
+/// Messages as JSON: every type, and the thesis' `total`.
+pub fn messages_json(messages: &[(&'static str, u64)]) -> Value {
+    let mut m = serde_json::Map::new();
+    for (name, count) in messages {
+        m.insert((*name).to_string(), (*count).into());
+    }
+    let total: u64 = messages
+        .iter()
+        .filter(|(n, _)| THESIS_MESSAGES.contains(n))
+        .map(|(_, c)| c)
+        .sum();
+    m.insert("total".into(), total.into());
+    Value::Object(m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn times_are_formatted_like_the_thesis() {
+        assert_eq!(format_time(0.0), "0.0");
+        assert_eq!(format_time(-0.0), "0.0");
+        assert_eq!(format_time(3.0), "3.0");
+        assert_eq!(format_time(0.1 + 0.2), "0.3");
+        assert_eq!(format_time(1.25), "1.25");
+        assert_eq!(format_time(-3.0), "-3.0");
+    }
+
+    #[test]
+    fn default_frame_times_are_round() {
+        assert_eq!(default_frame_time(4.0), 0.1);
+        assert_eq!(default_frame_time(3.0), 0.1);
+        assert_eq!(default_frame_time(100.0), 2.0);
+        assert_eq!(default_frame_time(0.3), 0.01);
+        assert_eq!(default_frame_time(0.0), 1.0);
+    }
+
+    #[test]
+    fn frame_times_reach_until() {
+        assert_eq!(frame_times(3.0, 1.0), vec![0.0, 1.0, 2.0, 3.0]);
+        assert_eq!(frame_times(0.35, 0.1).len(), 4);
+    }
+
+    #[test]
+    fn centroid_of_a_square() {
+        let sq = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(2.0, 0.0),
+            Vec2::new(2.0, 2.0),
+            Vec2::new(0.0, 2.0),
+        ];
+        assert_eq!(centroid(&sq), Vec2::new(1.0, 1.0));
+    }
+}
