@@ -22,6 +22,7 @@ pub mod model;
 pub mod output;
 pub mod physics;
 pub mod polygon;
+pub mod render;
 pub mod run;
 pub mod scenario;
 pub mod vtime;

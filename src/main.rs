@@ -109,13 +109,21 @@ enum Command {
         /// Print the summary as JSON.
         #[arg(long)]
         json: bool,
+        /// Where to write the player page (or FILE.gif, or a folder of frames).
+        #[arg(long, default_value = "poolsim-demo.html")]
+        out: PathBuf,
     },
+    /// Draw a run's frames (thesis 4.2): a folder of SVG and PNG frames, FILE.gif, or FILE.html
+    /// (one self-contained page with a player).
+    Render(Box<RenderArgs>),
     /// Measure events per second over ball counts and densities.
     Bench(poolsim::bench::BenchArgs),
     /// Run PHOLD, the standard PDES benchmark, and report committed events per second.
     Phold(PholdArgs),
     /// The analytic model of message counts (thesis ch. 7): F(s) and the best sector size.
     Model(ModelArgs),
+    /// Run the thesis' chapter 6 experiment (tables 5-10, figures 17-18) and write a report.
+    Experiment(poolsim::experiment::ExperimentArgs),
     /// Run from -Q to 0, reverse every ball, run on to Q, and report how far the balls end from
     /// where they started (thesis 4.6-4.7).
     Reverse(Box<ReverseArgs>),
@@ -637,17 +645,131 @@ fn print_summary(summary: &serde_json::Value, json: bool) {
     );
 }
 
-fn demo(json: bool) -> Result<(), Failure> {
-    let scenario = load("gas", &GenArgs::default())?;
-    let cfg = RunConfig {
-        engine: EngineKind::EventList,
-        until: scenario.until,
-        check: true,
-        span: Default::default(),
+/// Arguments of `poolsim render`.
+#[derive(clap::Args, Clone, Debug)]
+struct RenderArgs {
+    /// A built-in scenario name or a TOML file.
+    scenario: String,
+    /// A folder (frame-0000.svg and .png, ...), FILE.html (one page with a player) or FILE.gif.
+    #[arg(long)]
+    out: PathBuf,
+    /// Time between frames (default: about 40 frames, rounded to 1, 2 or 5 times a power of 10).
+    #[arg(long = "frame-time", allow_negative_numbers = true)]
+    frame_time: Option<f64>,
+    /// End time (default: the scenario's).
+    #[arg(long, allow_negative_numbers = true)]
+    until: Option<f64>,
+    /// event-list or objects.
+    #[arg(long, default_value = "event-list")]
+    engine: String,
+    /// Sectors: none, auto, N or NxM; drawn on any engine, run by the objects engine.
+    #[arg(long)]
+    sectors: Option<String>,
+    #[command(flatten)]
+    gen: GenArgs,
+    /// Delay of NewVelocity messages (objects engine).
+    #[arg(long = "newvelocity-delay")]
+    newvelocity_delay: Option<String>,
+    /// Check invariants at every event.
+    #[arg(long)]
+    check: bool,
+}
+
+/// Records a run and writes its frames where `out` says.
+fn render_to(
+    scenario: &Scenario,
+    cfg: &poolsim::render::RenderConfig,
+    out: &std::path::Path,
+) -> Result<(poolsim::render::Recording, String), Failure> {
+    use poolsim::render::{raster::Rasterizer, record, write, Output, RenderError};
+    let out = Output::from_path(out).map_err(usage)?;
+    let rasterizer = if out.needs_font() {
+        Some(Rasterizer::new().map_err(|e| internal(e.to_string()))?)
+    } else {
+        None
     };
-    let report = execute(&scenario, &cfg, &mut poolsim::engine::Ignore)
-        .map_err(|e| internal(e.to_string()))?;
-    print_summary(&report.summary, json);
+    let rec = record(scenario, cfg).map_err(|e| match e {
+        RunError::Input(m) => usage(m),
+        e => internal(e.to_string()),
+    })?;
+    let line = write(&rec, &out, rasterizer.as_ref()).map_err(|e| match e {
+        RenderError::Io { .. } => usage(e.to_string()),
+        e => internal(e.to_string()),
+    })?;
+    Ok((rec, line))
+}
+
+fn render(a: &RenderArgs) -> Result<(), Failure> {
+    let scenario = load(&a.scenario, &a.gen)?;
+    let run_args = RunArgs {
+        scenario: a.scenario.clone(),
+        engine: a.engine.clone(),
+        sectors: a.sectors.clone(),
+        until: a.until,
+        gen: a.gen.clone(),
+        trace: None,
+        final_state: None,
+        json: false,
+        check: a.check,
+        workers: None,
+        newvelocity_delay: a.newvelocity_delay.clone(),
+        dt: None,
+        quiet: true,
+    };
+    if a.engine == "time-step" {
+        return Err(usage("--engine: render draws with event-list or objects"));
+    }
+    let engine = engine_of(&run_args, &scenario)?;
+    if a.newvelocity_delay.is_some() && engine == EngineKind::EventList {
+        return Err(usage(
+            "--newvelocity-delay: only the objects engine takes it",
+        ));
+    }
+    let until = a.until.unwrap_or(scenario.until);
+    let frame_time = a
+        .frame_time
+        .unwrap_or_else(|| poolsim::render::default_frame_time(until));
+    let cfg = poolsim::render::RenderConfig {
+        check: a.check,
+        sectors: sector_choice(a.sectors.as_deref(), &scenario)?,
+        ..poolsim::render::RenderConfig::new(engine, until, frame_time)
+    };
+    let (_, line) = render_to(&scenario, &cfg, &a.out)?;
+    println!("wrote {line}");
+    Ok(())
+}
+
+/// The main job: the thesis' sectored 36-ball gas (plates 9-13: 2 x 2 sectors, frames every 0.1
+/// up to 4) on the objects engine, checked at every event, drawn as one page with a player.
+fn demo(json: bool, out: &std::path::Path) -> Result<(), Failure> {
+    let scenario = load("gas", &GenArgs::default())?;
+    let sectors = SectorChoice::Grid(2, 2);
+    let cfg = poolsim::render::RenderConfig {
+        check: true,
+        sectors: Some(sectors),
+        ..poolsim::render::RenderConfig::new(EngineKind::Sectored { sectors }, scenario.until, 0.1)
+    };
+    let (rec, line) = render_to(&scenario, &cfg, out)?;
+    let mut summary = rec.summary;
+    summary["sectors"] = "2x2".into();
+    summary["page"] = out.display().to_string().into();
+    print_summary(&summary, json);
+    if !json {
+        let m = &summary["messages"];
+        println!(
+            "messages      {} (thesis table 5 total: NewVelocity {}, Collision {}, Cancel {}, \
+             VelocityChange {}, SectorEntry {}, SectorDeparture {})",
+            m["total"],
+            m["NewVelocity"],
+            m["Collision"],
+            m["Cancel"],
+            m["VelocityChange"],
+            m["SectorEntry"],
+            m["SectorDeparture"]
+        );
+        println!("sectors       2 x 2 (thesis plates 9-13)");
+        println!("page          {line}");
+    }
     Ok(())
 }
 
@@ -661,11 +783,13 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::Run(a) => run(a),
-        Command::Demo { json } => demo(*json),
+        Command::Demo { json, out } => demo(*json, out),
+        Command::Render(a) => render(a),
         Command::Bench(b) => poolsim::bench::run(b).map_err(usage),
         Command::Phold(a) => phold(a),
         Command::Reverse(a) => reverse(a),
         Command::Model(a) => model(a),
+        Command::Experiment(a) => poolsim::experiment::run(a).map_err(usage),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

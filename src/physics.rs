@@ -53,8 +53,10 @@ fn approach(tref: f64, dp: Vec2, dv: Vec2, sigma: f64) -> Contact {
     }
     let a = dv.norm2();
     let disc = b * b - a * c;
-    if disc <= 0.0 {
-        return Contact::Never; // a miss, or a graze that exchanges no momentum
+    // a miss, a graze that exchanges no momentum, or speeds so large that the squares overflow
+    // (NaN): never an instant collision between balls that are apart
+    if disc.is_nan() || disc.is_infinite() || disc <= 0.0 {
+        return Contact::Never;
     }
     let tau = c / (disc.sqrt() - b);
     let t = tref + tau;
@@ -201,6 +203,13 @@ mod tests {
         assert_eq!(ball_ball_contact(&a, 1.0, &b, 1.0), Contact::Immediate);
         let away = traj(0.0, 0.0, -1.0, 0.0, 2.0);
         assert_eq!(ball_ball_contact(&away, 1.0, &b, 1.0), Contact::Never);
+    }
+
+    #[test]
+    fn overflowing_speeds_are_never_an_instant_collision() {
+        let a = traj(0.0, 0.0, 1e200, 0.0, 0.0);
+        let b = traj(180.0, 0.0, -1e200, 0.0, 0.0);
+        assert_ne!(ball_ball_contact(&a, 10.0, &b, 10.0), Contact::Immediate);
     }
 
     #[test]

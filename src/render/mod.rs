@@ -34,16 +34,18 @@ use crate::model::sectored::Layout;
 use crate::run::{execute, sector_layout, EngineKind, RunConfig, SectorChoice};
 use crate::scenario::Scenario;
 use serde_json::Value;
+use std::fmt;
+use std::path::{Path, PathBuf};
 
 /// The most frames one recording may hold.
 pub const MAX_FRAMES: usize = 20_000;
 
 /// The most ball positions (frames × balls) one recording may hold.
-pub const MAX_FRAME_BALLS: usize = 20_000_000;
+pub const MAX_FRAME_BALLS: usize = 2_000_000;
 
-/// The most trajectory pieces a recording keeps as its history; past this the HTML player
-/// interpolates between frames instead.
-pub const MAX_HISTORY: usize = 1_000_000;
+/// The most trajectory pieces a recording keeps as its history by default; past this the HTML
+/// player interpolates between frames instead (a piece is about 130 bytes of the page).
+pub const MAX_HISTORY: usize = 250_000;
 
 /// The message types whose sum is the thesis' total (table 5).
 pub const THESIS_MESSAGES: [&str; 6] = [
@@ -69,6 +71,23 @@ pub struct RenderConfig {
     /// The sectors to draw (none when `None`); a sectored engine draws its own layout whatever
     /// this says, unless it is `None`.
     pub sectors: Option<SectorChoice>,
+    /// The most trajectory pieces kept as the history ([`MAX_HISTORY`] by default).
+    pub max_history: usize,
+}
+
+impl RenderConfig {
+    /// Frames every `frame_time` up to `until` from `engine`; no checks, no sectors drawn, the
+    /// default history cap.
+    pub fn new(engine: EngineKind, until: f64, frame_time: f64) -> RenderConfig {
+        RenderConfig {
+            engine,
+            until,
+            frame_time,
+            check: false,
+            sectors: None,
+            max_history: MAX_HISTORY,
+        }
+    }
 }
 
 /// The fixed part of every frame: the table, the balls' names and sizes, the sectors.
@@ -141,7 +160,9 @@ impl History {
     pub fn frame_at(&self, t: f64) -> Frame {
         Frame {
             t,
-            balls: (0..self.pieces.len()).map(|i| self.state_at(i, t)).collect(),
+            balls: (0..self.pieces.len())
+                .map(|i| self.state_at(i, t))
+                .collect(),
         }
     }
 
@@ -178,7 +199,7 @@ pub struct Recording {
     pub frame_time: f64,
     /// The frames, at `0, F, 2F, …`.
     pub shots: Vec<Shot>,
-    /// The exact history, unless it was longer than [`MAX_HISTORY`] pieces.
+    /// The exact history, unless it was longer than the cap (`RenderConfig::max_history`).
     pub history: Option<History>,
     /// The run summary (as `poolsim run --json` prints it).
     pub summary: Value,
@@ -190,11 +211,13 @@ struct Recorder {
     frames: Vec<(Frame, EventCounts)>,
     history: Option<History>,
     pieces: usize,
+    cap: usize,
 }
 
 impl Recorder {
-    fn new(initial: &[BallState]) -> Recorder {
+    fn new(initial: &[BallState], cap: usize) -> Recorder {
         Recorder {
+            cap,
             counts: EventCounts::default(),
             frames: Vec::new(),
             history: Some(History {
@@ -211,6 +234,15 @@ impl Recorder {
             }),
             pieces: initial.len(),
         }
+        .capped()
+    }
+
+    /// Drops the history once it is longer than the cap.
+    fn capped(mut self) -> Recorder {
+        if self.pieces > self.cap {
+            self.history = None;
+        }
+        self
     }
 }
 
@@ -227,7 +259,7 @@ impl Observer for Recorder {
                 self.pieces += 1;
             }
             h.events.push(*ev);
-            if self.pieces > MAX_HISTORY {
+            if self.pieces > self.cap {
                 self.history = None;
             }
         }
@@ -342,7 +374,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
         }
     };
     let sectored = matches!(cfg.engine, EngineKind::Sectored { .. });
-    let mut rec = Recorder::new(&BallState::initial(scenario, 0.0));
+    let mut rec = Recorder::new(&BallState::initial(scenario, 0.0), cfg.max_history);
     let run = RunConfig {
         engine: cfg.engine,
         until: cfg.until,
@@ -391,6 +423,189 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
         history: rec.history,
         summary: report.summary,
     })
+}
+
+/// Where frames go, told by the path: `*.html` (or `.htm`) one page with a player, `*.gif` one
+/// animated GIF, anything else a folder of `frame-0000.svg` and `frame-0000.png`, ….
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// A folder of SVG and PNG frames.
+    Folder(PathBuf),
+    /// One self-contained HTML page.
+    Html(PathBuf),
+    /// One animated GIF.
+    Gif(PathBuf),
+}
+
+impl Output {
+    /// The output a path names, by its extension; a single picture file (`.png`, `.svg`, …) is
+    /// refused, since a run has many frames.
+    pub fn from_path(path: &Path) -> Result<Output, String> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        Ok(match ext.as_deref() {
+            Some("html" | "htm") => Output::Html(path.to_path_buf()),
+            Some("gif") => Output::Gif(path.to_path_buf()),
+            Some(ext @ ("png" | "svg" | "jpg" | "jpeg" | "webp")) => {
+                return Err(format!(
+                    "--out: {}: a run has many frames, so not one .{ext} file; give a folder \
+                     (frame-0000.svg and .png, ...), FILE.html or FILE.gif",
+                    path.display()
+                ))
+            }
+            _ => Output::Folder(path.to_path_buf()),
+        })
+    }
+
+    /// Whether this output needs the font (PNG and GIF frames do).
+    pub fn needs_font(&self) -> bool {
+        !matches!(self, Output::Html(_))
+    }
+}
+
+/// Why rendering failed.
+#[derive(Debug)]
+pub enum RenderError {
+    /// The run failed or its input is unusable.
+    Run(RunError),
+    /// A picture could not be made (no font, …).
+    Raster(raster::RasterError),
+    /// A file could not be written.
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// What went wrong.
+        error: std::io::Error,
+    },
+}
+
+impl fmt::Display for RenderError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RenderError::Run(e) => write!(f, "{e}"),
+            RenderError::Raster(e) => write!(f, "{e}"),
+            RenderError::Io { path, error } => {
+                write!(f, "{}: cannot write: {error}", path.display())
+            }
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+impl From<RunError> for RenderError {
+    fn from(e: RunError) -> RenderError {
+        RenderError::Run(e)
+    }
+}
+
+impl From<raster::RasterError> for RenderError {
+    fn from(e: raster::RasterError) -> RenderError {
+        RenderError::Raster(e)
+    }
+}
+
+fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> RenderError + '_ {
+    move |error| RenderError::Io {
+        path: path.to_path_buf(),
+        error,
+    }
+}
+
+/// `1 frame`, `2 frames`.
+fn frames(k: usize) -> String {
+    if k == 1 {
+        "1 frame".into()
+    } else {
+        format!("{k} frames")
+    }
+}
+
+/// The file name of frame `k` of `count` (`frame-0000`, with more digits past 10 000 frames).
+pub fn frame_name(k: usize, count: usize) -> String {
+    let width = count.saturating_sub(1).to_string().len().max(4);
+    format!("frame-{k:0width$}")
+}
+
+/// Writes a recording to `out`; `rasterizer` is needed for PNG and GIF frames. Returns one line
+/// that says what was written.
+pub fn write(
+    rec: &Recording,
+    out: &Output,
+    rasterizer: Option<&raster::Rasterizer>,
+) -> Result<String, RenderError> {
+    let need =
+        || raster::RasterError("PNG and GIF frames need a rasterizer with a font".to_string());
+    let style = svg::Style::default();
+    match out {
+        Output::Html(path) => {
+            std::fs::write(path, html::page(rec)).map_err(io_error(path))?;
+            Ok(format!(
+                "{}: one page, {} every {}, {}",
+                path.display(),
+                frames(rec.shots.len()),
+                format_time(rec.frame_time),
+                if rec.history.is_some() {
+                    "exact at any time"
+                } else {
+                    "interpolated between frames (the history was too long to embed)"
+                }
+            ))
+        }
+        Output::Folder(dir) => {
+            let r = rasterizer.ok_or_else(need)?;
+            std::fs::create_dir_all(dir).map_err(io_error(dir))?;
+            let count = rec.shots.len();
+            for (k, shot) in rec.shots.iter().enumerate() {
+                let text = svg::frame(&rec.scene, shot, &style);
+                let name = frame_name(k, count);
+                let p = dir.join(format!("{name}.svg"));
+                std::fs::write(&p, &text).map_err(io_error(&p))?;
+                let p = dir.join(format!("{name}.png"));
+                std::fs::write(&p, r.png(&text)?).map_err(io_error(&p))?;
+            }
+            Ok(format!(
+                "{}: {} every {} as SVG and PNG ({} to {})",
+                dir.display(),
+                frames(count),
+                format_time(rec.frame_time),
+                frame_name(0, count),
+                frame_name(count.saturating_sub(1), count)
+            ))
+        }
+        Output::Gif(path) => {
+            let r = rasterizer.ok_or_else(need)?;
+            let mut file = Some(std::fs::File::create(path).map_err(io_error(path))?);
+            let mut gif: Option<raster::GifWriter<std::io::BufWriter<std::fs::File>>> = None;
+            for shot in &rec.shots {
+                let pixmap = r.pixmap(&svg::frame(&rec.scene, shot, &style))?;
+                if let Some(file) = file.take() {
+                    gif = Some(raster::GifWriter::new(
+                        std::io::BufWriter::new(file),
+                        pixmap.width(),
+                        pixmap.height(),
+                        rec.frame_time,
+                    )?);
+                }
+                if let Some(g) = &mut gif {
+                    g.add(&pixmap)?;
+                }
+            }
+            if let Some(g) = gif {
+                let mut w = g.finish()?;
+                std::io::Write::flush(&mut w).map_err(io_error(path))?;
+            }
+            Ok(format!(
+                "{}: {}, one every {} s (frame time {})",
+                path.display(),
+                frames(rec.shots.len()),
+                format_time((rec.frame_time * 100.0).round().max(2.0) / 100.0),
+                format_time(rec.frame_time)
+            ))
+        }
+    }
 }
 
 /// A frame time for a run to `until` when none is given: about 40 frames, rounded to 1, 2 or 5

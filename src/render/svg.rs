@@ -20,16 +20,16 @@ use std::fmt::Write;
 pub const TABLE_PIXELS: f64 = 800.0;
 /// Room left and right of the table (pocket and cushion labels).
 pub const MARGIN_X: f64 = 110.0;
-/// Room above the table (title, labels).
-pub const MARGIN_TOP: f64 = 100.0;
-/// Room below the table (labels, counts).
-pub const MARGIN_BOTTOM: f64 = 100.0;
+/// Height of the title's band at the top (pixels).
+pub const TITLE_BAND: f64 = 56.0;
+/// Height of the counts' band at the bottom (pixels).
+pub const COUNTS_BAND: f64 = 40.0;
 /// Font size of labels and lists (pixels).
 pub const FONT: f64 = 12.0;
 /// Line height of lists (pixels).
 pub const LINE: f64 = 14.0;
 /// The most names a list under a label shows before `… N more`.
-pub const LIST_MAX: usize = 8;
+pub const LIST_MAX: usize = 6;
 /// Balls are named only on tables with at most this many balls.
 pub const MAX_NAMED_BALLS: usize = 400;
 /// Balls are named only when their radius is at least this many pixels.
@@ -106,14 +106,30 @@ impl View {
         } else {
             1.0
         };
+        // Room for the longest list under a pocket label above or below the table.
+        let lines = 1 + (scene.table.n_balls as usize).min(LIST_MAX);
+        let block = lines as f64 * LINE + 16.0;
+        let room = |side: &str| {
+            let facing = scene
+                .table
+                .pockets
+                .iter()
+                .any(|(from, to)| outward(*from, *to).3 == side);
+            if facing {
+                block
+            } else {
+                24.0
+            }
+        };
+        let (top, bottom) = (TITLE_BAND + room("up"), COUNTS_BAND + room("down"));
         View {
             scale,
             lo_x: lo.x,
             hi_y: hi.y,
             left: MARGIN_X,
-            top: MARGIN_TOP,
+            top,
             width: (span.x * scale + 2.0 * MARGIN_X).ceil(),
-            height: (span.y * scale + MARGIN_TOP + MARGIN_BOTTOM).ceil(),
+            height: (span.y * scale + top + bottom).ceil(),
         }
     }
 
@@ -154,29 +170,37 @@ impl Anchor {
 /// Where the label of a fixed segment (a pocket or cushion) from `from` to `to` stands: beyond
 /// its midpoint, `gap` pixels outside the table (the table lies on the right going from → to).
 pub fn outside_anchor(view: &View, from: Vec2, to: Vec2, gap: f64) -> Anchor {
-    let d = to - from;
-    let len = d.norm().max(f64::MIN_POSITIVE);
-    // outward in table coordinates is the left normal; flip y for the screen
-    let (nx, ny) = (-d.y / len, -(d.x / len));
+    let (nx, ny, h, v) = outward(from, to);
     let (mx, my) = view.px(Vec2::new((from.x + to.x) / 2.0, (from.y + to.y) / 2.0));
     Anchor {
         x: mx + nx * gap,
         y: my + ny * gap,
-        h: if nx > 0.4 {
-            "start"
-        } else if nx < -0.4 {
-            "end"
-        } else {
-            "middle"
-        },
-        v: if ny < -0.4 {
-            "up"
-        } else if ny > 0.4 {
-            "down"
-        } else {
-            "center"
-        },
+        h,
+        v,
     }
+}
+
+/// The outward unit normal of a fixed segment on the screen (`y` down), and how text beyond it
+/// is aligned: the table lies on the right going from → to, so outward is the left normal.
+fn outward(from: Vec2, to: Vec2) -> (f64, f64, &'static str, &'static str) {
+    let d = to - from;
+    let len = d.norm().max(f64::MIN_POSITIVE);
+    let (nx, ny) = (-d.y / len, -(d.x / len));
+    let h = if nx > 0.4 {
+        "start"
+    } else if nx < -0.4 {
+        "end"
+    } else {
+        "middle"
+    };
+    let v = if ny < -0.4 {
+        "up"
+    } else if ny > 0.4 {
+        "down"
+    } else {
+        "center"
+    };
+    (nx, ny, h, v)
 }
 
 /// The anchor of pocket `k`'s label.
@@ -236,13 +260,19 @@ fn n(x: f64) -> String {
     }
 }
 
-/// Writes a block of lines at an anchor.
+/// Writes a block of lines at an anchor; sector and pocket labels get a white outline under the
+/// letters so that they read over balls and vectors.
 fn text_block(out: &mut String, a: &Anchor, lines: &[String], class: &str, fill: &str, font: f64) {
     let line = LINE * font / FONT;
     let y0 = a.first_baseline(lines.len(), line, font);
+    let halo = if class.contains("sector-label") || class.contains("pocket-label") {
+        r#" stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke""#
+    } else {
+        ""
+    };
     let _ = write!(
         out,
-        r#"<text class="{class}" x="{}" y="{}" text-anchor="{}" font-size="{}" fill="{fill}">"#,
+        r#"<text class="{class}" x="{}" y="{}" text-anchor="{}" font-size="{}" fill="{fill}"{halo}>"#,
         n(a.x),
         n(y0),
         a.h,
@@ -267,11 +297,10 @@ pub fn ball_font(r_px: f64) -> f64 {
 
 /// Whether balls get names on this table at this view.
 pub fn names_balls(scene: &Scene, view: &View, balls: &[BallState]) -> bool {
-    let small = balls
-        .iter()
-        .map(|b| b.radius)
-        .fold(f64::INFINITY, f64::min);
-    balls.len() <= MAX_NAMED_BALLS && small * view.scale >= MIN_NAMED_RADIUS && scene.table.n_balls > 0
+    let small = balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
+    balls.len() <= MAX_NAMED_BALLS
+        && small * view.scale >= MIN_NAMED_RADIUS
+        && scene.table.n_balls > 0
 }
 
 /// The `<svg>` start tag with the coordinate mapping; `xmlns` for a file of its own.
@@ -481,7 +510,11 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
                 }
                 let (x, y) = view.px(b.traj.position);
                 let mut lines = vec![scene.table.name(i as u32)];
-                lines.extend(in_sectors[i].iter().map(|&k| Scene::sector_name(k as usize)));
+                lines.extend(
+                    in_sectors[i]
+                        .iter()
+                        .map(|&k| Scene::sector_name(k as usize)),
+                );
                 let a = Anchor {
                     x,
                     y,
@@ -520,14 +553,16 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
     }
     // Pocket labels and their lists are part of the state: always shown.
     for (k, names) in pocket_contents(scene, balls).into_iter().enumerate() {
-        let pocket = scene.table.name(scene.table.fixed_id(Fixed::Pocket(k as u32)));
+        let pocket = scene
+            .table
+            .name(scene.table.fixed_id(Fixed::Pocket(k as u32)));
         let a = pocket_anchor(scene, view, k);
         let lines = list_lines(pocket, names);
         text_block(&mut out, &a, &lines, "pocket-label", colour::TEXT, FONT);
     }
     let title = Anchor {
         x: view.width / 2.0,
-        y: 34.0,
+        y: 14.0,
         h: "middle",
         v: "down",
     };

@@ -240,6 +240,12 @@ impl Scenario {
             let f = format!("ball[{}]", i + 1);
             check_vec(&format!("{f}.position"), b.position)?;
             check_vec(&format!("{f}.velocity"), b.velocity)?;
+            if !b.velocity.norm2().is_finite() {
+                return Err(invalid(
+                    format!("{f}.velocity"),
+                    "is too large: its square overflows".into(),
+                ));
+            }
             check_positive(&format!("{f}.radius"), b.radius)?;
             check_positive(&format!("{f}.mass"), b.mass)?;
         }

@@ -1,0 +1,338 @@
+// poolsim player: draws the moving part of the picture (balls, vectors, names, the lists under
+// pocket and sector labels, the title and the counts) at any time, with the rules of
+// src/render/svg.rs (moving_layer). The data is the JSON in #poolsim-data; nothing is fetched.
+(function () {
+  'use strict';
+  const D = JSON.parse(document.getElementById('poolsim-data').textContent);
+  const V = D.view;
+  const C = D.consts;
+  const svg = document.getElementById('pool');
+  const dyn = document.getElementById('dyn');
+  const $ = (id) => document.getElementById(id);
+  const n = (x) => { const s = x.toFixed(2); return s === '-0.00' ? '0.00' : s; };
+  const px = (x, y) => [V.left + (x - V.lo_x) * V.scale, V.top + (V.hi_y - y) * V.scale];
+  const esc = (s) => String(s).replace(/&/g, '&amp;').replace(/</g, '&lt;').replace(/>/g, '&gt;');
+
+  // As src/render/mod.rs format_time for frame times (one decimal where that is exact); other
+  // times, met while playing, get four decimals.
+  function fmtTime(t) {
+    if (t === 0) t = 0;
+    for (let d = 1; d <= 4; d++) {
+      const p = Math.pow(10, d);
+      if (Math.abs(Math.round(t * p) / p - t) <= 1e-9 * Math.max(Math.abs(t), 1)) return t.toFixed(d);
+    }
+    return t.toFixed(4);
+  }
+
+  // ---- state at any time ------------------------------------------------------------------
+  const H = D.history;
+  const F = D.frames;
+  const nBalls = D.balls.length;
+
+  // Last index k in [0, len) with key(k) <= t, or -1.
+  function lastAtOrBefore(len, key, t) {
+    let lo = 0, hi = len;
+    while (lo < hi) { const mid = (lo + hi) >> 1; if (key(mid) <= t) lo = mid + 1; else hi = mid; }
+    return lo - 1;
+  }
+
+  // Cumulative event counts by kind, for exact counts at any time.
+  let cumulative = null;
+  if (H) {
+    const m = H.events.length;
+    cumulative = D.event_kinds.map(() => new Int32Array(m + 1));
+    for (let e = 0; e < m; e++) {
+      for (let k = 0; k < cumulative.length; k++) cumulative[k][e + 1] = cumulative[k][e];
+      cumulative[H.events[e][1]][e + 1] += 1;
+    }
+  }
+
+  function frameIndex(t) {
+    return Math.max(0, lastAtOrBefore(F.length, (k) => F[k].t, t));
+  }
+
+  // Every ball at time t, after every event up to and including t.
+  function ballsAt(t) {
+    const out = new Array(nBalls);
+    if (H) {
+      for (let i = 0; i < nBalls; i++) {
+        const path = H.pieces[i];
+        const k = Math.max(0, lastAtOrBefore(path.length, (j) => path[j][0], t));
+        const p = path[k];
+        if (p[6] !== null) out[i] = { x: p[1], y: p[2], vx: 0, vy: 0, pocket: p[6] };
+        else out[i] = { x: p[1] + (t - p[3]) * p[4], y: p[2] + (t - p[3]) * p[5], vx: p[4], vy: p[5], pocket: null };
+      }
+      return out;
+    }
+    // No history (too long to embed): linear between frames.
+    const k = frameIndex(t);
+    const a = F[k], b = F[Math.min(k + 1, F.length - 1)];
+    const s = b.t > a.t ? Math.min(1, Math.max(0, (t - a.t) / (b.t - a.t))) : 0;
+    for (let i = 0; i < nBalls; i++) {
+      const p = a.balls[i], q = b.balls[i];
+      if (p[4] !== null) out[i] = { x: p[0], y: p[1], vx: 0, vy: 0, pocket: p[4] };
+      else if (q[4] !== null) out[i] = { x: p[0] + (t - a.t) * p[2], y: p[1] + (t - a.t) * p[3], vx: p[2], vy: p[3], pocket: null };
+      else out[i] = { x: p[0] + s * (q[0] - p[0]), y: p[1] + s * (q[1] - p[1]), vx: p[2], vy: p[3], pocket: null };
+    }
+    return out;
+  }
+
+  function eventsAt(t) {
+    if (H) {
+      const e = lastAtOrBefore(H.events.length, (j) => H.events[j][0], t) + 1;
+      return cumulative.map((c) => c[e]);
+    }
+    return F[frameIndex(t)].events;
+  }
+
+  function messagesAt(t) {
+    const f = F[frameIndex(t)];
+    return f.messages ? { at: f.t, counts: f.messages } : null;
+  }
+
+  // ---- geometry of sectors (as src/polygon.rs: touches) --------------------------------------
+  function orient(a, b, p) {
+    const v = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+    return v > 0 ? 1 : v < 0 ? -1 : 0;
+  }
+  function contains(pts, p) {
+    let w = 0;
+    for (let k = 0; k < pts.length; k++) {
+      const a = pts[k], b = pts[(k + 1) % pts.length];
+      const inBox = p[0] >= Math.min(a[0], b[0]) && p[0] <= Math.max(a[0], b[0]) &&
+        p[1] >= Math.min(a[1], b[1]) && p[1] <= Math.max(a[1], b[1]);
+      if (inBox && orient(a, b, p) === 0) return true;
+      if (a[1] <= p[1]) { if (b[1] > p[1] && orient(a, b, p) > 0) w++; }
+      else if (b[1] <= p[1] && orient(a, b, p) < 0) w--;
+    }
+    return w !== 0;
+  }
+  function segDist2(p, a, b) {
+    const abx = b[0] - a[0], aby = b[1] - a[1];
+    const len2 = abx * abx + aby * aby;
+    let s = len2 > 0 ? ((p[0] - a[0]) * abx + (p[1] - a[1]) * aby) / len2 : 0;
+    s = Math.max(0, Math.min(1, s));
+    const dx = p[0] - (a[0] + s * abx), dy = p[1] - (a[1] + s * aby);
+    return dx * dx + dy * dy;
+  }
+  function touches(sector, c, r) {
+    const b = sector.bounds;
+    if (c[0] < b[0] - r || c[0] > b[2] + r || c[1] < b[1] - r || c[1] > b[3] + r) return false;
+    if (contains(sector.points, c)) return true;
+    let d = Infinity;
+    const pts = sector.points;
+    for (let k = 0; k < pts.length; k++) d = Math.min(d, segDist2(c, pts[k], pts[(k + 1) % pts.length]));
+    return d <= r * r;
+  }
+  for (const s of D.sectors) {
+    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+    for (const p of s.points) { x0 = Math.min(x0, p[0]); y0 = Math.min(y0, p[1]); x1 = Math.max(x1, p[0]); y1 = Math.max(y1, p[1]); }
+    s.bounds = [x0, y0, x1, y1];
+  }
+
+  // ---- drawing ------------------------------------------------------------------------------
+  function firstBaseline(a, count, line, font) {
+    const m = Math.max(count, 1);
+    if (a.v === 'up') return a.y - (m - 1) * line - 2;
+    if (a.v === 'down') return a.y + font;
+    return a.y - (m - 1) * line / 2 + 0.35 * font;
+  }
+  function textBlock(a, lines, cls, fill, font) {
+    const line = C.line * font / C.font;
+    const y0 = firstBaseline(a, lines.length, line, font);
+    let s = '<text class="' + cls + '" x="' + n(a.x) + '" y="' + n(y0) + '" text-anchor="' + a.h +
+      '" font-size="' + n(font) + '" fill="' + fill + '"' +
+      (cls.indexOf('sector-label') >= 0 || cls.indexOf('pocket-label') >= 0
+        ? ' stroke="white" stroke-width="3" stroke-linejoin="round" paint-order="stroke"' : '') + '>';
+    lines.forEach((l, i) => { s += '<tspan x="' + n(a.x) + '" y="' + n(y0 + i * line) + '">' + esc(l) + '</tspan>'; });
+    return s + '</text>';
+  }
+  function listLines(label, names) {
+    if (names.length > C.list_max) {
+      const more = names.length - (C.list_max - 1);
+      return [label].concat(names.slice(0, C.list_max - 1), ['\u2026 ' + more + ' more']);
+    }
+    return [label].concat(names);
+  }
+  function ballFont(rpx) { return Math.min(11, Math.max(7, rpx * 0.55)); }
+
+  function countsLines(t, ev, msg) {
+    const lines = ['events ' + ev.reduce((a, b) => a + b, 0) + ' (' +
+      D.event_kinds.map((k, i) => k + ' ' + ev[i]).join(', ') + ')'];
+    if (msg) {
+      const parts = D.message_types.filter((k) => msg.counts[k] > 0).map((k) => k + ' ' + msg.counts[k]);
+      const at = msg.at === t ? '' : ' at ' + fmtTime(msg.at);
+      lines.push('messages' + at + ' ' + msg.counts.total + ' (' + parts.join(', ') + ')');
+    }
+    return lines;
+  }
+
+  const style = { vectors: true, labels: true, sectors: D.sectors.length > 0 };
+  let current = null;
+
+  function draw(t) {
+    const balls = ballsAt(t);
+    const ev = eventsAt(t);
+    const msg = messagesAt(t);
+    const sectored = style.sectors && D.sectors.length > 0;
+    const inSectors = balls.map((b, i) => (sectored && b.pocket === null)
+      ? D.sectors.map((s, k) => touches(s, [b.x, b.y], D.balls[i].r) ? k : -1).filter((k) => k >= 0)
+      : []);
+    let s = '';
+    balls.forEach((b, i) => {
+      if (b.pocket !== null) return;
+      const [x, y] = px(b.x, b.y);
+      s += '<circle class="ball" data-ball="' + D.balls[i].name + '" cx="' + n(x) + '" cy="' + n(y) + '" r="' +
+        n(D.balls[i].r * V.scale) + '" fill="' + C.colours.ball + '" stroke="black" stroke-width="1.5"/>';
+    });
+    if (style.vectors) {
+      balls.forEach((b, i) => {
+        if (b.pocket !== null || (b.vx === 0 && b.vy === 0)) return;
+        const [x, y] = px(b.x, b.y);
+        const [hx, hy] = px(b.x + b.vx, b.y + b.vy);
+        s += '<line class="velocity" data-ball="' + D.balls[i].name + '" x1="' + n(x) + '" y1="' + n(y) + '" x2="' +
+          n(hx) + '" y2="' + n(hy) + '" stroke="' + C.colours.vector +
+          '" stroke-width="1.5" marker-end="url(#poolsim-arrow)"/>';
+      });
+    }
+    if (style.labels) {
+      if (C.names_balls) {
+        balls.forEach((b, i) => {
+          if (b.pocket !== null) return;
+          const [x, y] = px(b.x, b.y);
+          const lines = [D.balls[i].name].concat(inSectors[i].map((k) => D.sectors[k].name));
+          s += textBlock({ x: x, y: y, h: 'middle', v: 'center' }, lines, 'label ball-label', C.colours.text,
+            ballFont(D.balls[i].r * V.scale));
+        });
+      }
+      if (sectored) {
+        D.sectors.forEach((sec, k) => {
+          const names = [];
+          balls.forEach((b, i) => { if (inSectors[i].indexOf(k) >= 0) names.push(D.balls[i].name); });
+          s += textBlock(sec.anchor, listLines(sec.name, names), 'label sector-label', C.colours.sector, C.font);
+        });
+      }
+    }
+    D.pockets.forEach((p, k) => {
+      const names = [];
+      balls.forEach((b, i) => { if (b.pocket === k) names.push(D.balls[i].name); });
+      s += textBlock(p.anchor, listLines(p.name, names), 'pocket-label', C.colours.text, C.font);
+    });
+    s += textBlock({ x: V.width / 2, y: 14, h: 'middle', v: 'down' }, ['POOL SIMULATION AT ' + fmtTime(t)], 'title',
+      C.colours.text, 22);
+    s += textBlock({ x: 12, y: V.height - 8, h: 'start', v: 'up' }, countsLines(t, ev, msg), 'counts',
+      C.colours.quiet, 11);
+    dyn.innerHTML = s;
+    current = { t: t, balls: balls, events: ev, messages: msg };
+    showCounts(ev, msg);
+  }
+
+  // ---- the side panel -----------------------------------------------------------------------
+  function showCounts(ev, msg) {
+    let h = '<tr><th colspan="2">events up to now</th></tr>';
+    D.event_kinds.forEach((k, i) => { h += '<tr><td>' + k + '</td><td>' + ev[i] + '</td></tr>'; });
+    h += '<tr><td><b>total</b></td><td><b>' + ev.reduce((a, b) => a + b, 0) + '</b></td></tr>';
+    if (msg) {
+      h += '<tr><th colspan="2">messages sent up to frame ' + fmtTime(msg.at) + '</th></tr>';
+      D.message_types.forEach((k) => { h += '<tr><td>' + k + '</td><td>' + msg.counts[k] + '</td></tr>'; });
+      h += '<tr><td><b>total (thesis table 5)</b></td><td><b>' + msg.counts.total + '</b></td></tr>';
+    } else {
+      h += '<tr><th colspan="2">messages</th></tr><tr><td colspan="2">the ' + esc(D.engine) +
+        ' engine sends none</td></tr>';
+    }
+    $('counts').innerHTML = h;
+  }
+
+  // ---- controls -----------------------------------------------------------------------------
+  let t = 0, playing = false, last = null;
+  const slider = $('time');
+  slider.max = String(D.until);
+  slider.step = String(D.until > 0 ? D.until / 4000 : 1);
+
+  function seek(x) {
+    const v = Number(x);
+    if (!isFinite(v)) throw new Error('seek: not a number: ' + x);
+    t = Math.min(D.until, Math.max(0, v));
+    slider.value = String(t);
+    $('clock').textContent = fmtTime(t);
+    draw(t);
+    return state();
+  }
+  function state() {
+    return {
+      t: current.t,
+      balls: current.balls.map((b, i) => ({ name: D.balls[i].name, x: b.x, y: b.y, vx: b.vx, vy: b.vy,
+        pocket: b.pocket === null ? null : D.pocket_names[b.pocket] })),
+      events: Object.fromEntries(D.event_kinds.map((k, i) => [k, current.events[i]])),
+      messages: current.messages ? current.messages.counts : null,
+      exact: !!H,
+    };
+  }
+  function tick(now) {
+    if (!playing) return;
+    if (last !== null) {
+      let next = t + (now - last) / 1000 * Number($('speed').value);
+      if (next >= D.until) {
+        if ($('loop').checked) next = 0; else { next = D.until; pause(); }
+      }
+      seek(next);
+    }
+    last = now;
+    if (playing) requestAnimationFrame(tick);
+  }
+  function play() {
+    if (t >= D.until) seek(0);
+    playing = true; last = null; $('play').textContent = 'Pause';
+    requestAnimationFrame(tick);
+  }
+  function pause() { playing = false; $('play').textContent = 'Play'; }
+  function stepFrames(k) {
+    pause();
+    const i = frameIndex(t);
+    const j = Math.min(F.length - 1, Math.max(0, (F[i].t < t && k < 0) ? i : i + k));
+    seek(F[j].t);
+  }
+
+  $('play').addEventListener('click', () => (playing ? pause() : play()));
+  $('back').addEventListener('click', () => stepFrames(-1));
+  $('fwd').addEventListener('click', () => stepFrames(1));
+  slider.addEventListener('input', () => { pause(); seek(slider.value); });
+  function toggles() {
+    style.sectors = $('show-sectors').checked;
+    style.vectors = $('show-vectors').checked;
+    style.labels = $('show-labels').checked;
+    svg.classList.toggle('hide-sectors', !style.sectors);
+    svg.classList.toggle('hide-labels', !style.labels);
+    draw(t);
+  }
+  ['show-sectors', 'show-vectors', 'show-labels'].forEach((id) => $(id).addEventListener('change', toggles));
+  if (D.sectors.length === 0) { $('show-sectors').checked = false; $('show-sectors').disabled = true; }
+  document.addEventListener('keydown', (e) => {
+    if (e.target && e.target.tagName === 'SELECT') return;
+    if (e.key === ' ') { e.preventDefault(); playing ? pause() : play(); }
+    else if (e.key === 'ArrowRight') stepFrames(1);
+    else if (e.key === 'ArrowLeft') stepFrames(-1);
+  });
+
+  $('mode').textContent = H
+    ? 'Exact at any time: the run\u2019s trajectories are in the page.'
+    : 'Between frames, positions are interpolated linearly and counts are those of the last ' +
+      'frame (the run\u2019s trajectories were too long to put in the page).';
+
+  window.poolsim = { seek: seek, state: state, play: play, pause: pause, data: D };
+
+  // ?t=T seeks and stays paused; &dump=1 writes state() into #poolsim-state (for headless tests).
+  const q = new URLSearchParams(window.location.search);
+  toggles();
+  if (q.has('t')) {
+    seek(q.get('t'));
+    if (q.get('dump') === '1') {
+      const pre = $('poolsim-state');
+      pre.textContent = JSON.stringify(state());
+      pre.hidden = false;
+    }
+  } else {
+    seek(0);
+    play();
+  }
+})();
