@@ -56,6 +56,8 @@ const THESIS_ADJACENT: f64 = 4.0;
 pub enum Which {
     /// Thesis chapter 6 (tables 5-10) with the chapter 7 model (figures 17-18).
     Thesis,
+    /// Thesis 4.6-4.7: the reversal error against the quitting time Q.
+    Reversal,
 }
 
 /// Arguments of `poolsim experiment`.
@@ -2356,7 +2358,7 @@ static FONTS: Mutex<Vec<(PathBuf, &'static [u8])>> = Mutex::new(Vec::new());
 /// Reads the font at `path` and registers it as plotters' `sans-serif` (the family every text
 /// of the figures uses). A missing or unreadable font is an error naming the file and the
 /// Debian package, never a panic.
-fn register_font(path: &Path) -> Result<(), String> {
+pub(crate) fn register_font(path: &Path) -> Result<(), String> {
     let mut fonts = FONTS.lock().unwrap_or_else(|e| e.into_inner());
     let bytes = match fonts.iter().find(|f| f.0 == path) {
         Some(f) => f.1,
@@ -2731,10 +2733,14 @@ fn write_figure(dir: &Path, eq: u32, ms: &[Measured]) -> Result<(), String> {
         let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
         draw_figure(&root, eq, ms, &format!("{stem}.png"))?;
     }
-    let path = dir.join(format!("{stem}.png"));
+    write_png(&dir.join(format!("{stem}.png")), &buf, W, H)
+}
+
+/// Encodes an RGB buffer of `w` × `h` pixels as a PNG file.
+pub(crate) fn write_png(path: &Path, buf: &[u8], w: u32, h: u32) -> Result<(), String> {
     let mut png_bytes = Vec::new();
     {
-        let mut enc = png::Encoder::new(&mut png_bytes, W, H);
+        let mut enc = png::Encoder::new(&mut png_bytes, w, h);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);
         enc.set_compression(png::Compression::Best);
@@ -2742,10 +2748,10 @@ fn write_figure(dir: &Path, eq: u32, ms: &[Measured]) -> Result<(), String> {
         let mut w = enc
             .write_header()
             .map_err(|e| format!("encoding {}: {e}", path.display()))?;
-        w.write_image_data(&buf)
+        w.write_image_data(buf)
             .map_err(|e| format!("encoding {}: {e}", path.display()))?;
     }
-    write(&path, &png_bytes)
+    write(path, &png_bytes)
 }
 
 fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
@@ -2854,7 +2860,13 @@ fn results_json(data: &Data, fs: &[Finding]) -> Value {
 /// report, then the figures. Errors are one line for the user (bad arguments, a failed run, an
 /// unwritable directory, a missing font); files written before an error stay.
 pub fn run(args: &ExperimentArgs) -> Result<(), String> {
-    let Which::Thesis = args.which;
+    if args.which == Which::Reversal {
+        let font = args
+            .font
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(DEFAULT_FONT));
+        return crate::reversal_study::run(&args.out, &font, args.quick);
+    }
     let plan = Plan::from_args(args)?;
     let dir = &args.out;
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;

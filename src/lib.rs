@@ -23,6 +23,7 @@ pub mod output;
 pub mod physics;
 pub mod polygon;
 pub mod render;
+pub mod reversal_study;
 pub mod run;
 pub mod scenario;
 pub mod vtime;

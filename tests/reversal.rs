@@ -98,3 +98,16 @@ fn forward_and_backward_events_mirror_each_other() {
         assert!((f.t + b.t).abs() < 1e-9, "{} vs {}", f.t, b.t);
     }
 }
+
+#[test]
+fn the_reversal_study_writes_its_table_and_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let font = std::path::Path::new("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf");
+    poolsim::reversal_study::run(dir.path(), font, true).unwrap();
+    let table = std::fs::read_to_string(dir.path().join("reversal.md")).unwrap();
+    assert!(table.contains("| 3 | event-list | 112 |"), "{table}");
+    let png = std::fs::read(dir.path().join("reversal_error.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let svg = std::fs::read_to_string(dir.path().join("reversal_error.svg")).unwrap();
+    assert!(svg.starts_with("<svg") || svg.starts_with("<?xml"));
+}
