@@ -51,6 +51,9 @@ pub struct TimeStep {
     grid: Grid,
     dt: f64,
     t: f64,
+    start: f64,
+    /// Whole steps of `dt` taken since the start.
+    steps_done: u64,
     reverse_at: Option<f64>,
     /// Balls to come back out of their pocket after the reversal: (time, ball, pocket id).
     returns: Vec<(f64, u32, u32)>,
@@ -73,6 +76,8 @@ impl TimeStep {
             grid,
             dt: opts.dt,
             t: opts.span.start,
+            start: opts.span.start,
+            steps_done: 0,
             reverse_at: opts.span.reverse_at,
             returns: Vec::new(),
             stats: Stats::default(),
@@ -236,12 +241,17 @@ impl TimeStep {
                 Some(r) if r > self.t && r < until => r,
                 _ => until,
             };
-            let step = self.dt.min(stop - self.t);
-            self.t = if step < self.dt {
-                stop
+            // Steps end on the grid start + k dt (no drift from adding dt up), or at the stop;
+            // a grid point within a hair of the stop is the stop, so no sliver step follows.
+            let prev = self.t;
+            let next = self.start + (self.steps_done + 1) as f64 * self.dt;
+            if next <= stop + 1e-9 * self.dt {
+                self.steps_done += 1;
+                self.t = next.min(stop);
             } else {
-                self.t + self.dt
-            };
+                self.t = stop;
+            }
+            let step = self.t - prev;
             self.stats.steps += 1;
             for i in 0..n {
                 let b = &mut self.balls[i as usize];
