@@ -302,7 +302,8 @@ pub fn measure_objects(
     if let Some(choice) = sectors {
         scenario.until = 1.0;
         let layout = crate::run::sector_layout(&scenario, choice)?;
-        let mut engine = crate::engine::objects::Objects::sectored(&scenario, layout);
+        let mut engine =
+            crate::engine::objects::Objects::sectored(&scenario, layout, Default::default());
         let out = engine
             .run(scenario.until, &mut Ignore)
             .map_err(|e| e.to_string())?;

@@ -177,6 +177,9 @@ struct ReverseArgs {
     /// event-list, time-step or objects.
     #[arg(long, default_value = "event-list")]
     engine: String,
+    /// Sector layout of the objects engine: none, auto, N or NxM.
+    #[arg(long)]
+    sectors: Option<String>,
     #[command(flatten)]
     gen: GenArgs,
     /// Time step of the time-step engine.
@@ -204,7 +207,7 @@ fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
     let run_args = RunArgs {
         scenario: a.scenario.clone(),
         engine: a.engine.clone(),
-        sectors: None,
+        sectors: a.sectors.clone(),
         until: None,
         gen: a.gen.clone(),
         trace: None,

@@ -180,13 +180,13 @@ pub fn execute(
             e.run(cfg.until, &mut sinks)?
         }
         EngineKind::Sectored { sectors } => {
-            if cfg.span != Span::default() {
+            if cfg.span.frame_time.is_some() {
                 return Err(RunError::Input(
-                    "reversal and frames are not available on sectored tables yet".into(),
+                    "the sectored engine draws no frames itself (poolsim render does)".into(),
                 ));
             }
             let layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
-            let mut e = Objects::sectored(scenario, layout);
+            let mut e = Objects::sectored(scenario, layout, cfg.span);
             e.run(cfg.until, &mut sinks)?
         }
     };

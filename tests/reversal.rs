@@ -36,6 +36,12 @@ fn thesis_4_7_returns_every_ball_to_its_start() {
     assert_eq!(a.events, b.events);
     assert_eq!(a.max_position_error, b.max_position_error);
     assert_eq!(a.max_velocity_error, b.max_velocity_error);
+    for k in [1, 2, 5] {
+        let sectors = poolsim::run::SectorChoice::Grid(k, k);
+        let d = reverse(&s, EngineKind::Sectored { sectors }, 3.0, true).unwrap();
+        assert_eq!(a.events, d.events, "{k} sectors per side");
+        assert_eq!(a.max_position_error, d.max_position_error);
+    }
     let c = reverse(&s, EngineKind::TimeStep { dt: 1e-3 }, 3.0, false).unwrap();
     assert!(c.max_position_error < 1e-3, "{}", c.max_position_error);
 }
@@ -43,7 +49,10 @@ fn thesis_4_7_returns_every_ball_to_its_start() {
 #[test]
 fn a_pocketed_ball_comes_back_out_at_the_mirror_time() {
     let s = build("plate1", &Params::default()).unwrap();
-    for engine in [EngineKind::EventList, objects()] {
+    let sectored = EngineKind::Sectored {
+        sectors: poolsim::run::SectorChoice::Grid(3, 3),
+    };
+    for engine in [EngineKind::EventList, objects(), sectored] {
         let cfg = RunConfig {
             engine,
             until: 3.0,

@@ -85,10 +85,14 @@ impl Objects {
         ))
     }
 
-    /// Sets the sectored objects up at time 0 over `layout`.
-    pub fn sectored(s: &Scenario, layout: Layout) -> Objects {
-        let (model, states) = Sectored::new(s, layout);
-        Objects::Sectored(Sequential::new(model, states, VTime::at(Key::start(0.0))))
+    /// Sets the sectored objects up at `span.start` over `layout`.
+    pub fn sectored(s: &Scenario, layout: Layout, span: Span) -> Objects {
+        let (model, states) = Sectored::new(s, layout, span);
+        Objects::Sectored(Sequential::new(
+            model,
+            states,
+            VTime::at(Key::start(span.start)),
+        ))
     }
 
     /// Message statistics so far.

@@ -25,13 +25,13 @@
 //! those of the event-list engine.
 
 use super::pool::{BallInfo, Planned};
-use crate::engine::{Event, EventKind, Fixed, Table};
+use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::{Trajectory, Vec2};
 use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
 use crate::physics::{self, Contact};
 use crate::polygon::{self, Polygon};
 use crate::scenario::Scenario;
-use crate::vtime::{pair, Key, DEPARTURE};
+use crate::vtime::{pair, Key, DEPARTURE, REVERSAL};
 use std::sync::Arc;
 
 /// The sectors of a table: their polygons, which touch which, and a bucket index of their boxes
@@ -176,6 +176,10 @@ pub enum SecMsg {
         /// The receiver's trajectory version as the scheduler knew it.
         seen: Key,
     },
+    /// Turn around now (thesis 4.6), sent by each ball to itself at the start.
+    ReverseYourself,
+    /// Come back out of the pocket now (thesis fig. 13), sent by a pocketed ball to itself.
+    ReturnToTable,
     /// Before a ball–ball collision: is the sender still on the trajectory it was predicted for?
     CollisionConfirm {
         /// Whether the sender's own trajectory is still the one the collision was computed for.
@@ -213,7 +217,7 @@ pub enum SecMsg {
     },
 }
 
-const KIND_NAMES: [&str; 7] = [
+const KIND_NAMES: [&str; 9] = [
     "NewVelocity",
     "Collision",
     "VelocityChange",
@@ -221,6 +225,8 @@ const KIND_NAMES: [&str; 7] = [
     "SectorDeparture",
     "VelocityInitialization",
     "CollisionConfirm",
+    "ReverseYourself",
+    "ReturnToTable",
 ];
 
 /// A sector's scheduled entry or departure of one ball.
@@ -270,11 +276,13 @@ pub enum SecState {
 pub struct Sectored {
     table: Table,
     layout: Layout,
+    span: Span,
 }
 
 impl Sectored {
-    /// The model and initial states of a validated scenario over `layout`, starting at 0.
-    pub fn new(s: &Scenario, layout: Layout) -> (Sectored, Vec<SecState>) {
+    /// The model and initial states of a validated scenario over `layout`, starting at
+    /// `span.start` (frames are not drawn here).
+    pub fn new(s: &Scenario, layout: Layout, span: Span) -> (Sectored, Vec<SecState>) {
         let table = Table::new(s);
         let n = table.n_balls;
         let first_sector = n + table.n_fixed();
@@ -285,11 +293,11 @@ impl Sectored {
                 traj: Trajectory {
                     position: b.position,
                     velocity: b.velocity,
-                    t0: 0.0,
+                    t0: span.start,
                 },
                 radius: b.radius,
                 mass: b.mass,
-                fixed: Key::start(0.0),
+                fixed: Key::start(span.start),
                 pocket: None,
             });
             let sectors: Vec<u32> = layout
@@ -318,7 +326,14 @@ impl Sectored {
                 planned: Vec::new(),
             });
         }
-        (Sectored { table, layout }, states)
+        (
+            Sectored {
+                table,
+                layout,
+                span,
+            },
+            states,
+        )
     }
 
     /// The table.
@@ -495,6 +510,46 @@ impl Sectored {
                         );
                         planned.push(p);
                     }
+                }
+                SecMsg::ReverseYourself => {
+                    let now = ctx.now().clone();
+                    let me_info = Arc::make_mut(info);
+                    match me_info.pocket {
+                        None => {
+                            me_info.traj.position = me_info.traj.at(now.t());
+                            me_info.traj.t0 = now.t();
+                            me_info.fixed = now.key.clone();
+                            changed = true;
+                        }
+                        Some(k) => {
+                            let back = 2.0 * now.t() - me_info.traj.t0;
+                            me_info.traj.t0 = back;
+                            let f = self.table.fixed_id(Fixed::Pocket(k));
+                            let key = super::pool::return_key(&now.key, back, pair(me, f));
+                            ctx.send_at(me, VTime::at(key), SecMsg::ReturnToTable);
+                        }
+                    }
+                    me_info.traj.velocity = -me_info.traj.velocity;
+                }
+                SecMsg::ReturnToTable => {
+                    let now = ctx.now().clone();
+                    let me_info = Arc::make_mut(info);
+                    let k = me_info.pocket.take().expect("only a pocketed ball returns");
+                    me_info.fixed = now.key.clone();
+                    let first = self.first_sector();
+                    *sectors = self
+                        .layout
+                        .touching(me_info.traj.position, me_info.radius)
+                        .into_iter()
+                        .map(|s| first + s)
+                        .collect();
+                    changed = true;
+                    ctx.emit(Event {
+                        t: now.t(),
+                        kind: EventKind::BallPocket,
+                        a: me,
+                        b: self.table.fixed_id(Fixed::Pocket(k)),
+                    });
                 }
                 SecMsg::SectorEntry { sector, .. } => {
                     if !sectors.contains(sector) {
@@ -798,8 +853,11 @@ impl Sectored {
                         planned.push(p);
                     }
                 }
-                SecMsg::Collision { .. } | SecMsg::CollisionConfirm { .. } => {
-                    unreachable!("sectors take part in no collision")
+                SecMsg::Collision { .. }
+                | SecMsg::CollisionConfirm { .. }
+                | SecMsg::ReverseYourself
+                | SecMsg::ReturnToTable => {
+                    unreachable!("sectors take part in no collision and never turn around")
                 }
             }
         }
@@ -824,6 +882,8 @@ impl Model for Sectored {
             SecMsg::SectorDeparture { .. } => 4,
             SecMsg::VelocityInitialization { .. } => 5,
             SecMsg::CollisionConfirm { .. } => 6,
+            SecMsg::ReverseYourself => 7,
+            SecMsg::ReturnToTable => 8,
         }
     }
 
@@ -831,11 +891,12 @@ impl Model for Sectored {
     fn priority(&self, msg: &SecMsg) -> u8 {
         match msg {
             SecMsg::Collision { .. } => 0,
-            SecMsg::CollisionConfirm { .. } => 1,
+            SecMsg::CollisionConfirm { .. } | SecMsg::ReturnToTable => 1,
             SecMsg::SectorEntry { .. } => 2,
             SecMsg::VelocityChange { .. } | SecMsg::VelocityInitialization { .. } => 3,
             SecMsg::NewVelocity { .. } => 4,
             SecMsg::SectorDeparture { .. } => 5,
+            SecMsg::ReverseYourself => 6,
         }
     }
 
@@ -853,6 +914,9 @@ impl Model for Sectored {
                 );
             }
             self.tell_fixed(ctx, me, info);
+            if let Some(t) = self.span.reverse_at {
+                ctx.send_at(me, VTime::at(Key::at(t, REVERSAL)), SecMsg::ReverseYourself);
+            }
         }
     }
 

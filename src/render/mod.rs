@@ -336,7 +336,7 @@ fn chunked(
         EngineKind::Objects { delay } => Objects::new(scenario, delay, Span::default()),
         EngineKind::Sectored { sectors } => {
             let layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
-            Objects::sectored(scenario, layout)
+            Objects::sectored(scenario, layout, Default::default())
         }
         EngineKind::EventList | EngineKind::TimeStep { .. } => return Ok(None),
     };
