@@ -473,6 +473,11 @@ fn browse(browser: &str, page: &Path, t: &str) -> (serde_json::Value, Vec<String
 #[test]
 fn the_page_in_a_browser_shows_the_trace_s_positions() {
     let Some(browser) = chromium() else {
+        // CI installs Chromium and sets POOLSIM_REQUIRE_BROWSER, so there this never skips.
+        assert!(
+            std::env::var_os("POOLSIM_REQUIRE_BROWSER").is_none(),
+            "POOLSIM_REQUIRE_BROWSER is set but no headless Chromium was found"
+        );
         eprintln!(
             "skipped: no headless browser (install Debian's `chromium` package to run this test)"
         );
