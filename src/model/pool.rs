@@ -55,6 +55,43 @@ pub struct BallInfo {
     pub pocket: Option<u32>,
 }
 
+impl BallInfo {
+    /// Turns ball `me` around at `now` (thesis 4.6, fig. 13). On the table it takes a position fix
+    /// and reverses: `None`, its trajectory changed now. In a pocket it reverses the crossing it
+    /// dropped in by and returns the key at which it comes back out (the mirror image in time).
+    pub fn reverse(&mut self, me: u32, now: &VTime, table: &Table) -> Option<Key> {
+        let back = match self.pocket {
+            None => {
+                self.traj.position = self.traj.at(now.t());
+                self.traj.t0 = now.t();
+                self.fixed = now.key.clone();
+                None
+            }
+            Some(k) => {
+                let back = 2.0 * now.t() - self.traj.t0;
+                self.traj.t0 = back;
+                let f = table.fixed_id(Fixed::Pocket(k));
+                Some(return_key(&now.key, back, pair(me, f)))
+            }
+        };
+        self.traj.velocity = -self.traj.velocity;
+        back
+    }
+
+    /// Ball `me` comes back out of its pocket at `now`: the event to report (a mirrored pocket
+    /// crossing).
+    pub fn come_back(&mut self, me: u32, now: &VTime, table: &Table) -> Event {
+        let k = self.pocket.take().expect("only a pocketed ball returns");
+        self.fixed = now.key.clone();
+        Event {
+            t: now.t(),
+            kind: EventKind::BallPocket,
+            a: me,
+            b: table.fixed_id(Fixed::Pocket(k)),
+        }
+    }
+}
+
 /// Messages of the pool simulation.
 #[derive(Clone, Debug)]
 pub enum PoolMsg {
@@ -366,24 +403,12 @@ impl Pool {
                 }
                 PoolMsg::ReverseYourself => {
                     let now = ctx.now().clone();
-                    let me_info = Arc::make_mut(info);
-                    match me_info.pocket {
-                        None => {
-                            me_info.traj.position = me_info.traj.at(now.t());
-                            me_info.traj.t0 = now.t();
-                            me_info.fixed = now.key.clone();
-                            changed = true;
-                        }
-                        Some(k) => {
-                            // out again at the mirror image of the time it dropped in
-                            let back = 2.0 * now.t() - me_info.traj.t0;
-                            me_info.traj.t0 = back;
-                            let f = self.table.fixed_id(Fixed::Pocket(k));
-                            let key = return_key(&now.key, back, pair(me, f));
-                            ctx.send_at(me, VTime::at(key), PoolMsg::ReturnToTable);
+                    match Arc::make_mut(info).reverse(me, &now, &self.table) {
+                        None => changed = true,
+                        Some(back) => {
+                            ctx.send_at(me, VTime::at(back), PoolMsg::ReturnToTable);
                         }
                     }
-                    me_info.traj.velocity = -me_info.traj.velocity;
                 }
                 PoolMsg::DisplayYourself => {
                     let t = ctx.now().t();
@@ -396,17 +421,9 @@ impl Pool {
                 }
                 PoolMsg::ReturnToTable => {
                     let now = ctx.now().clone();
-                    let me_info = Arc::make_mut(info);
-                    let k = me_info.pocket.take().expect("only a pocketed ball returns");
-                    me_info.fixed = now.key.clone();
+                    let ev = Arc::make_mut(info).come_back(me, &now, &self.table);
                     changed = true;
-                    let f = self.table.fixed_id(Fixed::Pocket(k));
-                    ctx.emit(PoolOutput::Event(Event {
-                        t: now.t(),
-                        kind: EventKind::BallPocket,
-                        a: me,
-                        b: f,
-                    }));
+                    ctx.emit(PoolOutput::Event(ev));
                 }
                 PoolMsg::NewVelocity(x) => {
                     let from = env.from;

@@ -513,43 +513,25 @@ impl Sectored {
                 }
                 SecMsg::ReverseYourself => {
                     let now = ctx.now().clone();
-                    let me_info = Arc::make_mut(info);
-                    match me_info.pocket {
-                        None => {
-                            me_info.traj.position = me_info.traj.at(now.t());
-                            me_info.traj.t0 = now.t();
-                            me_info.fixed = now.key.clone();
-                            changed = true;
-                        }
-                        Some(k) => {
-                            let back = 2.0 * now.t() - me_info.traj.t0;
-                            me_info.traj.t0 = back;
-                            let f = self.table.fixed_id(Fixed::Pocket(k));
-                            let key = super::pool::return_key(&now.key, back, pair(me, f));
-                            ctx.send_at(me, VTime::at(key), SecMsg::ReturnToTable);
+                    match Arc::make_mut(info).reverse(me, &now, &self.table) {
+                        None => changed = true,
+                        Some(back) => {
+                            ctx.send_at(me, VTime::at(back), SecMsg::ReturnToTable);
                         }
                     }
-                    me_info.traj.velocity = -me_info.traj.velocity;
                 }
                 SecMsg::ReturnToTable => {
                     let now = ctx.now().clone();
-                    let me_info = Arc::make_mut(info);
-                    let k = me_info.pocket.take().expect("only a pocketed ball returns");
-                    me_info.fixed = now.key.clone();
+                    let ev = Arc::make_mut(info).come_back(me, &now, &self.table);
                     let first = self.first_sector();
                     *sectors = self
                         .layout
-                        .touching(me_info.traj.position, me_info.radius)
+                        .touching(info.traj.position, info.radius)
                         .into_iter()
                         .map(|s| first + s)
                         .collect();
                     changed = true;
-                    ctx.emit(Event {
-                        t: now.t(),
-                        kind: EventKind::BallPocket,
-                        a: me,
-                        b: self.table.fixed_id(Fixed::Pocket(k)),
-                    });
+                    ctx.emit(ev);
                 }
                 SecMsg::SectorEntry { sector, .. } => {
                     if !sectors.contains(sector) {
