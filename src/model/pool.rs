@@ -151,6 +151,25 @@ pub struct Planned {
     pub other: Handle,
 }
 
+impl Planned {
+    /// Retracts both Collision messages (two thesis Cancel messages).
+    pub fn cancel<M: Model + ?Sized>(self, ctx: &mut Ctx<'_, M>) {
+        ctx.cancel(self.own);
+        ctx.cancel(self.other);
+    }
+}
+
+/// Cancels the collision `planned` holds with `partner`, if any.
+pub fn cancel_with<M: Model + ?Sized>(
+    ctx: &mut Ctx<'_, M>,
+    planned: &mut Vec<Planned>,
+    partner: u32,
+) {
+    if let Some(k) = planned.iter().position(|p| p.partner == partner) {
+        planned.swap_remove(k).cancel(ctx);
+    }
+}
+
 /// A pool object's state.
 #[derive(Clone, Debug)]
 pub enum PoolState {
@@ -318,15 +337,6 @@ impl Pool {
         }
     }
 
-    /// Cancels what `planned` holds with `partner`, if anything.
-    fn cancel_with(ctx: &mut Ctx<'_, Pool>, planned: &mut Vec<Planned>, partner: u32) {
-        if let Some(k) = planned.iter().position(|p| p.partner == partner) {
-            let p = planned.swap_remove(k);
-            ctx.cancel(p.own);
-            ctx.cancel(p.other);
-        }
-    }
-
     fn ball_batch(
         &self,
         ctx: &mut Ctx<'_, Pool>,
@@ -427,7 +437,7 @@ impl Pool {
                 }
                 PoolMsg::NewVelocity(x) => {
                     let from = env.from;
-                    Self::cancel_with(ctx, planned, from);
+                    cancel_with(ctx, planned, from);
                     if info.pocket.is_some() || x.pocket.is_some() {
                         continue;
                     }
@@ -461,8 +471,7 @@ impl Pool {
         }
         if changed {
             for p in planned.drain(..) {
-                ctx.cancel(p.own);
-                ctx.cancel(p.other);
+                p.cancel(ctx);
             }
             let n = self.n_objects();
             self.broadcast(ctx, me, info, (0..n).filter(|&o| o != me));
@@ -493,7 +502,7 @@ impl Pool {
                 }
                 PoolMsg::NewVelocity(x) => {
                     let from = env.from;
-                    Self::cancel_with(ctx, planned, from);
+                    cancel_with(ctx, planned, from);
                     if x.pocket.is_none() {
                         holds.retain(|&b| b != from); // back out after a reversal
                     }

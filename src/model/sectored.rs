@@ -24,7 +24,7 @@
 //! on the trajectories it was predicted for. With zero delays the physical events are then exactly
 //! those of the event-list engine.
 
-use super::pool::{BallInfo, Planned};
+use super::pool::{cancel_with, BallInfo, Planned};
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::{Trajectory, Vec2};
 use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
@@ -405,14 +405,6 @@ impl Sectored {
         }
     }
 
-    fn cancel_with(ctx: &mut Ctx<'_, Sectored>, planned: &mut Vec<Planned>, partner: u32) {
-        if let Some(k) = planned.iter().position(|p| p.partner == partner) {
-            let p = planned.swap_remove(k);
-            ctx.cancel(p.own);
-            ctx.cancel(p.other);
-        }
-    }
-
     fn key_of(contact: Contact, parent: &Key, p: crate::vtime::Pair) -> Option<Key> {
         match contact {
             Contact::Never => None,
@@ -478,7 +470,7 @@ impl Sectored {
                         continue;
                     }
                     seen_balls.push(*ball);
-                    Self::cancel_with(ctx, planned, *ball);
+                    cancel_with(ctx, planned, *ball);
                     if info.pocket.is_some() || x.pocket.is_some() {
                         continue;
                     }
@@ -546,8 +538,7 @@ impl Sectored {
         }
         if changed {
             for p in planned.drain(..) {
-                ctx.cancel(p.own);
-                ctx.cancel(p.other);
+                p.cancel(ctx);
             }
             for &s in sectors.iter() {
                 ctx.send_now(
@@ -657,7 +648,7 @@ impl Sectored {
                     }
                 }
                 SecMsg::NewVelocity { ball, info: x } => {
-                    Self::cancel_with(ctx, planned, *ball);
+                    cancel_with(ctx, planned, *ball);
                     if x.pocket.is_some() {
                         continue;
                     }
