@@ -47,7 +47,7 @@ pub fn unpair(p: Pair) -> (u32, u32) {
 }
 
 /// A point of virtual time: a time and the path of pairs that orders events within an instant.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Key {
     /// Simulation time.
     pub t: f64,

@@ -22,13 +22,14 @@
 //! object's send counter (which names its messages) lives beside its state for the same reason.
 
 pub mod sequential;
+pub mod time_warp;
 
 use crate::vtime::Key;
 use std::cmp::Ordering;
 use std::fmt::Debug;
 
 /// Virtual time: a key and the generation of zero-delay sends within it.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct VTime {
     /// The key (time and pair path).
     pub key: Key,
@@ -82,7 +83,7 @@ pub struct Handle {
 }
 
 /// A message as delivered: its payload, its sender and its name.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Envelope<M> {
     /// The sending object.
     pub from: u32,
@@ -120,7 +121,7 @@ pub trait Model {
 }
 
 /// A message waiting to be delivered.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Pending<M> {
     /// When it arrives.
     pub time: VTime,
@@ -233,7 +234,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
 }
 
 /// Message counts by type, as sent, and cancellations.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct MessageStats {
     /// Sent messages by type index.
     pub sent: Vec<u64>,
@@ -252,6 +253,19 @@ impl MessageStats {
             self.sent.resize(kind + 1, 0);
         }
         self.sent[kind] += 1;
+    }
+
+    /// Adds another executor's counts.
+    pub fn add(&mut self, o: &MessageStats) {
+        for (k, &n) in o.sent.iter().enumerate() {
+            if self.sent.len() <= k {
+                self.sent.resize(k + 1, 0);
+            }
+            self.sent[k] += n;
+        }
+        self.cancels += o.cancels;
+        self.batches += o.batches;
+        self.delivered += o.delivered;
     }
 
     /// The count of type `kind`.

@@ -253,3 +253,59 @@ mod tests {
         assert!((0..1000).all(|_| model.partition(model.draw(3, &mut rng).0) == 0));
     }
 }
+
+#[cfg(test)]
+mod time_warp_tests {
+    use super::*;
+    use crate::kernel::sequential::Sequential;
+    use crate::kernel::time_warp::threads::TimeWarp;
+    use crate::kernel::time_warp::TwConfig;
+
+    fn cfg(partitions: u32) -> PholdConfig {
+        PholdConfig {
+            objects: 96,
+            events_per_object: 4,
+            remote: 0.3,
+            partitions,
+            lookahead: 0.0,
+            mean: 1.0,
+            seed: 11,
+        }
+    }
+
+    #[test]
+    fn time_warp_commits_the_sequential_run() {
+        for workers in [1usize, 2, 3] {
+            for chaos in [None, Some(7)] {
+                let c = cfg(workers as u32);
+                let (model, states) = Phold::new(c.clone());
+                let mut seq = Sequential::new(model, states, VTime::at(Key::start(0.0)));
+                seq.run::<()>(30.0, &mut |_, _, _| Ok(())).unwrap();
+                let (model, states) = Phold::new(c);
+                let worker_of: Vec<u32> = (0..96).map(|o| model.partition(o)).collect();
+                let tw_cfg = TwConfig {
+                    workers,
+                    chaos,
+                    gvt_interval: 64,
+                    ..Default::default()
+                };
+                let mut tw = TimeWarp::new(
+                    model,
+                    states,
+                    VTime::at(Key::start(0.0)),
+                    &worker_of,
+                    tw_cfg,
+                );
+                tw.run::<()>(30.0, &mut |_, _, _| Ok(())).unwrap();
+                let a: Vec<(u64, u64)> =
+                    seq.states().iter().map(|s| (s.handled, s.sends)).collect();
+                let b: Vec<(u64, u64)> = tw.states().iter().map(|s| (s.handled, s.sends)).collect();
+                assert_eq!(a, b, "workers {workers} chaos {chaos:?}");
+                assert_eq!(seq.stats(), tw.stats(), "workers {workers} chaos {chaos:?}");
+                let st = tw.tw_stats();
+                assert_eq!(st.committed, seq.stats().batches);
+                eprintln!("workers {workers} chaos {chaos:?}: {st:?}");
+            }
+        }
+    }
+}

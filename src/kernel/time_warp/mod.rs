@@ -1,0 +1,994 @@
+//! The Time Warp executor (Jefferson 1985; thesis 1, 2.3): the kernel's objects run
+//! optimistically in parallel and commit exactly the sequential executor's batches.
+//!
+//! ```text
+//!   worker 0                         worker 1
+//!   ┌───────────────────────┐  ops   ┌───────────────────────┐
+//!   │ objects (LPs):        │ ─────► │ entries: uid → count  │
+//!   │  state, history of    │ ◄───── │ heap of live, un-     │
+//!   │  done batches         │        │ processed messages    │
+//!   └───────────┬───────────┘        └───────────┬───────────┘
+//!               └──── GVT round (reduce) ────────┘──► committed chunks ─► collector ─► sink
+//! ```
+//!
+//! Each worker owns a set of objects and runs, one batch at a time, the lowest virtual time it
+//! holds, without waiting for the others. A message that arrives in an object's past (a
+//! straggler) rolls that object back: its saved states are restored (copy state saving) and
+//! everything the undone batches sent is retracted by anti-messages (aggressive cancellation).
+//!
+//! Transport names every message by a `uid` that is never reused (the sender's object index and
+//! a counter that is not rolled back), so an anti-message finds its message whatever the order
+//! of arrival: an entry counts positives minus anti-messages, and model-level cancellations
+//! (`Ctx::cancel`) minus their undoing; a message is live when it has one positive and no
+//! cancellation. Every change of liveness in an object's past rolls the object back to it.
+//!
+//! A model cancellation takes effect only where the sequential executor's would: when the
+//! cancelled message comes after the cancelling batch in the (virtual time, receiver) order of
+//! batches; otherwise it was already delivered and the cancellation does nothing.
+//!
+//! GVT (global virtual time) is found in synchronous rounds, as ROSS does: workers stop
+//! processing, drain their inboxes until a reduction says every op sent has been received,
+//! then reduce the smallest simulation time they still hold. Batches before it are committed:
+//! their output goes, in (virtual time, object) order, to the collector, and their saved states
+//! are freed (fossil collection). The transport and the reductions are a [`Fabric`]: threads
+//! ([`threads`]) or MPI ranks.
+
+pub mod threads;
+
+use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rustc_hash::FxHashMap;
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, VecDeque};
+
+/// Time Warp's settings.
+#[derive(Clone, Debug)]
+pub struct TwConfig {
+    /// Worker threads (per rank under MPI).
+    pub workers: usize,
+    /// Seed of chaos mode: deliveries delayed and reordered at random to force rollbacks.
+    pub chaos: Option<u64>,
+    /// Batches a worker runs between GVT rounds.
+    pub gvt_interval: u32,
+    /// Optimism window: no batch later than GVT plus this (simulation time).
+    pub window: Option<f64>,
+    /// Uncommitted batches a worker may hold before it rolls its furthest objects back and
+    /// runs only batches at GVT; past four times this, the run stops with an error.
+    pub max_uncommitted: usize,
+}
+
+impl Default for TwConfig {
+    fn default() -> TwConfig {
+        TwConfig {
+            workers: 1,
+            chaos: None,
+            gvt_interval: 2048,
+            window: None,
+            max_uncommitted: 1 << 21,
+        }
+    }
+}
+
+/// What Time Warp did, summed over workers (the run summary's `time_warp` object).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TwStats {
+    /// Workers in all.
+    pub workers: u64,
+    /// MPI ranks (1 on threads).
+    pub ranks: u64,
+    /// Batches run, rolled-back ones included.
+    pub processed: u64,
+    /// Batches committed.
+    pub committed: u64,
+    /// Batches undone by rollbacks.
+    pub rolled_back: u64,
+    /// Rollbacks (one object rolled back once).
+    pub rollbacks: u64,
+    /// Of them, rollbacks a worker made itself to free memory.
+    pub artificial_rollbacks: u64,
+    /// Messages sent to an object on another worker.
+    pub remote_messages: u64,
+    /// Messages sent in all (local and remote, rolled-back sends included).
+    pub messages: u64,
+    /// Anti-messages sent.
+    pub anti_messages: u64,
+    /// GVT rounds.
+    pub gvt_rounds: u64,
+    /// The most uncommitted batches (saved states) one worker held at once.
+    pub peak_uncommitted: u64,
+    /// The most messages (entries) one worker held at once.
+    pub peak_entries: u64,
+}
+
+impl TwStats {
+    /// Committed over processed batches.
+    pub fn efficiency(&self) -> f64 {
+        if self.processed == 0 {
+            1.0
+        } else {
+            self.committed as f64 / self.processed as f64
+        }
+    }
+
+    /// Adds another worker's counts (peaks take the maximum).
+    pub fn add(&mut self, o: &TwStats) {
+        self.workers += o.workers;
+        self.processed += o.processed;
+        self.committed += o.committed;
+        self.rolled_back += o.rolled_back;
+        self.rollbacks += o.rollbacks;
+        self.artificial_rollbacks += o.artificial_rollbacks;
+        self.remote_messages += o.remote_messages;
+        self.messages += o.messages;
+        self.anti_messages += o.anti_messages;
+        self.gvt_rounds = self.gvt_rounds.max(o.gvt_rounds);
+        self.peak_uncommitted = self.peak_uncommitted.max(o.peak_uncommitted);
+        self.peak_entries = self.peak_entries.max(o.peak_entries);
+    }
+}
+
+/// One unit of transport between workers.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub enum Op<Msg> {
+    /// A message.
+    Msg {
+        /// Its transport name.
+        uid: u64,
+        /// The message.
+        p: Pending<Msg>,
+    },
+    /// The anti-message of `uid`.
+    Anti {
+        /// The message it annuls.
+        uid: u64,
+        /// Its receiver.
+        to: u32,
+        /// Its time.
+        time: VTime,
+    },
+    /// A model cancellation of `uid` (`sign` 1) or the undoing of one (`sign` -1).
+    Cancel {
+        /// The cancelled message.
+        uid: u64,
+        /// Its receiver.
+        to: u32,
+        /// Its time.
+        time: VTime,
+        /// 1 to cancel, -1 to undo.
+        sign: i8,
+    },
+}
+
+impl<Msg> Op<Msg> {
+    /// The receiving object.
+    pub fn to(&self) -> u32 {
+        match self {
+            Op::Msg { p, .. } => p.to,
+            Op::Anti { to, .. } | Op::Cancel { to, .. } => *to,
+        }
+    }
+
+    /// The virtual time the op affects.
+    pub fn time(&self) -> &VTime {
+        match self {
+            Op::Msg { p, .. } => &p.time,
+            Op::Anti { time, .. } | Op::Cancel { time, .. } => time,
+        }
+    }
+}
+
+/// The values a GVT round reduces over all workers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reduction {
+    /// Ops sent minus ops received (summed).
+    pub in_flight: i64,
+    /// The smallest simulation time held (minimum).
+    pub min_t: f64,
+    /// Workers asked to stop (summed).
+    pub stop: u64,
+}
+
+impl Reduction {
+    /// Combines two workers' values.
+    pub fn combine(self, o: Reduction) -> Reduction {
+        Reduction {
+            in_flight: self.in_flight + o.in_flight,
+            min_t: self.min_t.min(o.min_t),
+            stop: self.stop + o.stop,
+        }
+    }
+}
+
+/// One committed batch as the collector needs it.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Committed<S, O> {
+    /// Its virtual time.
+    pub time: VTime,
+    /// The object that ran it.
+    pub obj: u32,
+    /// The object's state after it.
+    pub state: S,
+    /// What it reported.
+    pub output: Vec<O>,
+}
+
+/// What a worker hands the collector after a GVT round.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+pub struct Chunk<S, O> {
+    /// The worker.
+    pub worker: usize,
+    /// The round.
+    pub round: u64,
+    /// Batches committed in this round, in (time, object) order.
+    pub batches: Vec<Committed<S, O>>,
+    /// Set on the worker's last chunk of a run: its statistics.
+    pub last: Option<(TwStats, MessageStats, u64)>,
+    /// Set when the worker stopped on an error.
+    pub error: Option<String>,
+}
+
+/// How workers reach each other: delivery of ops, reductions and the collector.
+pub trait Fabric<M: Model>: Sync {
+    /// Sends ops to worker `to`.
+    fn send(&self, from: usize, to: usize, ops: Vec<Op<M::Msg>>);
+    /// Appends every op that has arrived for worker `me`.
+    fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>);
+    /// Reduces `local` over every worker; all workers call it the same number of times.
+    fn reduce(&self, me: usize, local: Reduction) -> Reduction;
+    /// Hands a chunk of committed batches to the collector.
+    fn commit(&self, chunk: Chunk<M::State, M::Output>);
+}
+
+/// A message received and not yet committed.
+struct Entry<Msg> {
+    /// Positives minus anti-messages: 1 when the message is here and not annulled.
+    pos: i8,
+    /// Model cancellations minus their undoing.
+    cancels: i32,
+    /// The message, while `pos` is 1.
+    p: Option<Pending<Msg>>,
+    /// Whether a batch not rolled back has handled it.
+    processed: bool,
+}
+
+impl<Msg> Entry<Msg> {
+    fn live(&self) -> bool {
+        self.pos == 1 && self.cancels == 0
+    }
+}
+
+/// A heap entry: a live message's delivery order and its uid.
+struct Item {
+    time: VTime,
+    to: u32,
+    priority: u8,
+    from: u32,
+    seq: u64,
+    uid: u64,
+}
+
+impl Item {
+    fn of<M>(uid: u64, p: &Pending<M>) -> Item {
+        Item {
+            time: p.time.clone(),
+            to: p.to,
+            priority: p.priority,
+            from: p.env.from,
+            seq: p.env.seq,
+            uid,
+        }
+    }
+
+    fn order(&self, o: &Item) -> Ordering {
+        self.time
+            .cmp(&o.time)
+            .then(self.to.cmp(&o.to))
+            .then(self.priority.cmp(&o.priority))
+            .then(self.from.cmp(&o.from))
+            .then(self.seq.cmp(&o.seq))
+            .then(self.uid.cmp(&o.uid))
+    }
+}
+
+impl PartialEq for Item {
+    fn eq(&self, o: &Self) -> bool {
+        self.order(o) == Ordering::Equal
+    }
+}
+
+impl Eq for Item {}
+
+impl PartialOrd for Item {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl Ord for Item {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.order(self)
+    }
+}
+
+/// A message an object sent, as its sender remembers it.
+#[derive(Clone, Debug)]
+struct Sent {
+    uid: u64,
+    to: u32,
+    time: VTime,
+}
+
+/// A batch an object ran that is not committed yet.
+struct Done<M: Model> {
+    time: VTime,
+    pre_state: M::State,
+    pre_seq: u64,
+    inputs: Vec<u64>,
+    sent: Vec<(Sent, u16)>,
+    cancels: Vec<Sent>,
+    cancel_calls: u32,
+    output: Vec<M::Output>,
+}
+
+/// One object (a logical process) on its worker.
+struct Lp<M: Model> {
+    id: u32,
+    state: M::State,
+    seq: u64,
+    uids: u64,
+    history: VecDeque<Done<M>>,
+    /// Messages it sent that may still be cancelled, by send sequence.
+    sends: FxHashMap<u64, Sent>,
+}
+
+impl<M: Model> Lp<M> {
+    fn last_time(&self) -> Option<&VTime> {
+        self.history.back().map(|d| &d.time)
+    }
+
+    fn next_uid(&mut self) -> u64 {
+        self.uids += 1;
+        (u64::from(self.id) << 40) | self.uids
+    }
+}
+
+/// Where each object lives: its worker and its index there.
+#[derive(Clone, Debug)]
+pub struct Placement {
+    place: Vec<(u32, u32)>,
+    workers: usize,
+}
+
+impl Placement {
+    /// The placement of objects given each one's worker.
+    pub fn new(worker_of: &[u32], workers: usize) -> Placement {
+        let mut counts = vec![0u32; workers];
+        let place = worker_of
+            .iter()
+            .map(|&w| {
+                let k = counts[w as usize];
+                counts[w as usize] += 1;
+                (w, k)
+            })
+            .collect();
+        Placement { place, workers }
+    }
+
+    /// The worker of object `o`.
+    pub fn worker(&self, o: u32) -> usize {
+        self.place[o as usize].0 as usize
+    }
+
+    fn local(&self, o: u32) -> usize {
+        self.place[o as usize].1 as usize
+    }
+
+    /// Objects on worker `w`, in index order.
+    pub fn objects_of(&self, w: usize) -> impl Iterator<Item = u32> + '_ {
+        (0..self.place.len() as u32).filter(move |&o| self.worker(o) == w)
+    }
+
+    /// Number of workers.
+    pub fn workers(&self) -> usize {
+        self.workers
+    }
+}
+
+/// One worker: its objects, its messages, its outboxes.
+pub struct Worker<M: Model> {
+    index: usize,
+    placement: std::sync::Arc<Placement>,
+    lps: Vec<Lp<M>>,
+    entries: FxHashMap<u64, Entry<M::Msg>>,
+    heap: BinaryHeap<Item>,
+    local_ops: Vec<Op<M::Msg>>,
+    outbox: Vec<Vec<Op<M::Msg>>>,
+    /// Chaos mode: its random stream and the ops it holds back, with their release iteration.
+    chaos: Option<(ChaCha8Rng, Vec<(u64, Op<M::Msg>)>)>,
+    iteration: u64,
+    sent_ops: i64,
+    received_ops: i64,
+    uncommitted: usize,
+    gvt: f64,
+    round: u64,
+    stats: TwStats,
+    committed_stats: MessageStats,
+    /// Memory samples (uncommitted batches plus entries) after each GVT round.
+    samples: Vec<u64>,
+}
+
+/// Why a worker stopped early.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stop {
+    /// Another worker or the collector asked to stop.
+    Asked,
+    /// This worker could not stay within its memory budget.
+    Memory(String),
+}
+
+impl<M: Model> Worker<M> {
+    /// A worker holding the objects `placement` gives it, with their initial states.
+    pub fn new(
+        index: usize,
+        placement: std::sync::Arc<Placement>,
+        states: Vec<(u32, M::State)>,
+        chaos: Option<u64>,
+    ) -> Worker<M> {
+        let workers = placement.workers();
+        Worker {
+            index,
+            lps: states
+                .into_iter()
+                .map(|(id, state)| Lp {
+                    id,
+                    state,
+                    seq: 0,
+                    uids: 0,
+                    history: VecDeque::new(),
+                    sends: FxHashMap::default(),
+                })
+                .collect(),
+            placement,
+            entries: FxHashMap::default(),
+            heap: BinaryHeap::new(),
+            local_ops: Vec::new(),
+            outbox: (0..workers).map(|_| Vec::new()).collect(),
+            chaos: chaos.map(|s| {
+                (
+                    ChaCha8Rng::seed_from_u64(s ^ (index as u64).wrapping_mul(0x9e37_79b9)),
+                    Vec::new(),
+                )
+            }),
+            iteration: 0,
+            sent_ops: 0,
+            received_ops: 0,
+            uncommitted: 0,
+            gvt: f64::NEG_INFINITY,
+            round: 0,
+            stats: TwStats {
+                workers: 1,
+                ranks: 1,
+                ..Default::default()
+            },
+            committed_stats: MessageStats::default(),
+            samples: Vec::new(),
+        }
+    }
+
+    /// Runs every object's `init` at `start`; its sends are routed like any others (flush
+    /// them with [`Worker::take_outbox`]). Init sends are committed at once.
+    pub fn init(&mut self, model: &M, start: &VTime) {
+        for k in 0..self.lps.len() {
+            let lp = &mut self.lps[k];
+            let mut ctx = Ctx::new(model, start.clone(), lp.id, &mut lp.seq);
+            model.init(&mut ctx, lp.id, &mut lp.state);
+            let sent = ctx.sent;
+            assert!(ctx.cancelled.is_empty(), "init may not cancel");
+            for p in sent {
+                self.committed_stats.count(model.kind(&p.env.msg));
+                let lp = &mut self.lps[k];
+                let uid = lp.next_uid();
+                lp.sends.insert(
+                    p.env.seq,
+                    Sent {
+                        uid,
+                        to: p.to,
+                        time: p.time.clone(),
+                    },
+                );
+                self.route(Op::Msg { uid, p });
+            }
+        }
+        self.drain_local();
+    }
+
+    /// Takes the ops waiting for other workers: `(worker, ops)`.
+    pub fn take_outbox(&mut self) -> Vec<(usize, Vec<Op<M::Msg>>)> {
+        let mut out = Vec::new();
+        for (w, ops) in self.outbox.iter_mut().enumerate() {
+            if !ops.is_empty() {
+                self.sent_ops += ops.len() as i64;
+                out.push((w, std::mem::take(ops)));
+            }
+        }
+        out
+    }
+
+    /// Accepts ops handed over outside a fabric (at set-up).
+    pub fn accept(&mut self, ops: Vec<Op<M::Msg>>) {
+        self.received_ops += ops.len() as i64;
+        for op in ops {
+            self.apply(op);
+        }
+        self.drain_local();
+    }
+
+    /// This worker's objects' current states, by object index.
+    pub fn states(&self) -> impl Iterator<Item = (u32, &M::State)> {
+        self.lps.iter().map(|lp| (lp.id, &lp.state))
+    }
+
+    /// Live messages waiting (not handled) on this worker.
+    pub fn pending_len(&self) -> usize {
+        self.entries
+            .values()
+            .filter(|e| e.live() && !e.processed)
+            .count()
+    }
+
+    /// Memory samples (uncommitted batches plus held messages) after each GVT round.
+    pub fn samples(&self) -> &[u64] {
+        &self.samples
+    }
+
+    fn route(&mut self, op: Op<M::Msg>) {
+        let w = self.placement.worker(op.to());
+        match &op {
+            Op::Msg { .. } => {
+                self.stats.messages += 1;
+                if w != self.index {
+                    self.stats.remote_messages += 1;
+                }
+            }
+            Op::Anti { .. } => self.stats.anti_messages += 1,
+            Op::Cancel { .. } => {}
+        }
+        if w == self.index {
+            self.local_ops.push(op);
+        } else {
+            self.outbox[w].push(op);
+        }
+    }
+
+    fn drain_local(&mut self) {
+        while let Some(op) = self.local_ops.pop() {
+            self.apply(op);
+        }
+    }
+
+    /// Applies one op to its entry, rolling the receiver back if its past changes.
+    fn apply(&mut self, op: Op<M::Msg>) {
+        let to = op.to();
+        let (uid, time) = match &op {
+            Op::Msg { uid, p } => (*uid, p.time.clone()),
+            Op::Anti { uid, time, .. } | Op::Cancel { uid, time, .. } => (*uid, time.clone()),
+        };
+        let e = self.entries.entry(uid).or_insert(Entry {
+            pos: 0,
+            cancels: 0,
+            p: None,
+            processed: false,
+        });
+        let before = e.live();
+        match op {
+            Op::Msg { p, .. } => {
+                e.pos += 1;
+                e.p = (e.pos == 1).then_some(p);
+            }
+            Op::Anti { .. } => {
+                e.pos -= 1;
+                e.p = None;
+            }
+            Op::Cancel { sign, .. } => e.cancels += i32::from(sign),
+        }
+        let after = e.live();
+        if e.pos == 0 && e.cancels == 0 {
+            self.entries.remove(&uid);
+        }
+        if before != after {
+            let li = self.placement.local(to);
+            if self.lps[li].last_time().is_some_and(|t| *t >= time) {
+                self.rollback(li, &time);
+            }
+            if after {
+                let e = &self.entries[&uid];
+                let p = e.p.as_ref().expect("a live entry holds its message");
+                self.heap.push(Item::of(uid, p));
+            }
+        }
+        self.stats.peak_entries = self.stats.peak_entries.max(self.entries.len() as u64);
+    }
+
+    /// Undoes every batch of local object `li` at `time` or later.
+    fn rollback(&mut self, li: usize, time: &VTime) {
+        self.stats.rollbacks += 1;
+        while self.lps[li].last_time().is_some_and(|t| t >= time) {
+            let lp = &mut self.lps[li];
+            let d = lp.history.pop_back().expect("a batch to undo");
+            self.uncommitted -= 1;
+            self.stats.rolled_back += 1;
+            lp.state = d.pre_state;
+            lp.seq = d.pre_seq;
+            for s in d.pre_seq + 1..=d.pre_seq + d.sent.len() as u64 {
+                lp.sends.remove(&s);
+            }
+            for uid in d.inputs {
+                if let Some(e) = self.entries.get_mut(&uid) {
+                    e.processed = false;
+                    if e.live() {
+                        let p = e.p.as_ref().expect("a live entry holds its message");
+                        self.heap.push(Item::of(uid, p));
+                    }
+                }
+            }
+            for (s, _) in d.sent {
+                self.route(Op::Anti {
+                    uid: s.uid,
+                    to: s.to,
+                    time: s.time,
+                });
+            }
+            for c in d.cancels {
+                self.route(Op::Cancel {
+                    uid: c.uid,
+                    to: c.to,
+                    time: c.time,
+                    sign: -1,
+                });
+            }
+        }
+    }
+
+    /// Whether a heap item still names a live, unhandled message.
+    fn valid(&self, it: &Item) -> bool {
+        self.entries
+            .get(&it.uid)
+            .is_some_and(|e| e.live() && !e.processed)
+    }
+
+    /// The smallest time of a live, unhandled message here (stale heap items dropped).
+    fn next_time(&mut self) -> Option<f64> {
+        while let Some(top) = self.heap.peek() {
+            if self.valid(top) {
+                return Some(top.time.t());
+            }
+            self.heap.pop();
+        }
+        None
+    }
+
+    /// Runs the next batch if its time is at most `limit`; false when there is none.
+    fn step(&mut self, model: &M, limit: f64) -> bool {
+        match self.next_time() {
+            Some(t) if t <= limit => {}
+            _ => return false,
+        }
+        let first = self.heap.pop().expect("a valid top");
+        let (time, to) = (first.time.clone(), first.to);
+        let mut uids = vec![first.uid];
+        while let Some(top) = self.heap.peek() {
+            if top.time != time || top.to != to {
+                break;
+            }
+            let it = self.heap.pop().expect("a top");
+            if self.valid(&it) && uids.last() != Some(&it.uid) {
+                uids.push(it.uid);
+            }
+        }
+        let batch: Vec<Envelope<M::Msg>> = uids
+            .iter()
+            .map(|u| {
+                let e = self.entries.get_mut(u).expect("a valid entry");
+                e.processed = true;
+                e.p.as_ref().expect("a live entry").env.clone()
+            })
+            .collect();
+        let li = self.placement.local(to);
+        let lp = &mut self.lps[li];
+        debug_assert!(
+            lp.last_time().is_none_or(|t| *t < time),
+            "batches run in order"
+        );
+        let pre_state = lp.state.clone();
+        let pre_seq = lp.seq;
+        let mut ctx = Ctx::new(model, time.clone(), to, &mut lp.seq);
+        model.handle(&mut ctx, to, &mut lp.state, &batch);
+        let (sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
+        let mut ops = Vec::with_capacity(sent.len());
+        let mut sent_recs = Vec::with_capacity(sent.len());
+        for p in sent {
+            let uid = lp.next_uid();
+            let s = Sent {
+                uid,
+                to: p.to,
+                time: p.time.clone(),
+            };
+            lp.sends.insert(p.env.seq, s.clone());
+            sent_recs.push((s, model.kind(&p.env.msg) as u16));
+            ops.push(Op::Msg { uid, p });
+        }
+        let mut cancels = Vec::new();
+        for h in &cancelled {
+            if let Some(s) = lp.sends.get(&h.seq) {
+                // after this batch in the sequential order: not delivered yet
+                if (&s.time, s.to) > (&time, to) {
+                    cancels.push(s.clone());
+                }
+            }
+        }
+        for c in &cancels {
+            ops.push(Op::Cancel {
+                uid: c.uid,
+                to: c.to,
+                time: c.time.clone(),
+                sign: 1,
+            });
+        }
+        lp.history.push_back(Done {
+            time,
+            pre_state,
+            pre_seq,
+            inputs: uids,
+            sent: sent_recs,
+            cancels,
+            cancel_calls: cancelled.len() as u32,
+            output,
+        });
+        self.uncommitted += 1;
+        self.stats.processed += 1;
+        self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
+        for op in ops {
+            self.route(op);
+        }
+        self.drain_local();
+        true
+    }
+
+    /// Rolls back every object that ran past the next message here, to free saved states.
+    fn artificial_rollback(&mut self) {
+        let Some(top) = self.heap.peek() else { return };
+        let t = top.time.clone();
+        for li in 0..self.lps.len() {
+            if self.lps[li].last_time().is_some_and(|x| *x >= t) {
+                self.stats.artificial_rollbacks += 1;
+                self.rollback(li, &t);
+            }
+        }
+        self.drain_local();
+    }
+
+    /// Takes what arrived; in chaos mode holds it back a few iterations and shuffles it.
+    fn receive<F: Fabric<M>>(&mut self, fabric: &F, buf: &mut Vec<Op<M::Msg>>) {
+        fabric.recv(self.index, buf);
+        self.received_ops += buf.len() as i64;
+        match &mut self.chaos {
+            None => {
+                for op in buf.drain(..) {
+                    self.apply(op);
+                }
+            }
+            Some((rng, held)) => {
+                for op in buf.drain(..) {
+                    let delay = rng.gen_range(0..4u64);
+                    held.push((self.iteration + delay, op));
+                }
+                let now = self.iteration;
+                let mut due: Vec<Op<M::Msg>> = Vec::new();
+                let mut k = 0;
+                while k < held.len() {
+                    if held[k].0 <= now {
+                        due.push(held.swap_remove(k).1);
+                    } else {
+                        k += 1;
+                    }
+                }
+                for i in (1..due.len()).rev() {
+                    let j = rng.gen_range(0..=i);
+                    due.swap(i, j);
+                }
+                for op in due {
+                    self.apply(op);
+                }
+            }
+        }
+        self.drain_local();
+    }
+
+    fn flush<F: Fabric<M>>(&mut self, fabric: &F) {
+        for (w, ops) in self.take_outbox() {
+            fabric.send(self.index, w, ops);
+        }
+    }
+
+    /// The smallest time this worker still holds: unhandled messages and held ops.
+    fn local_min(&mut self) -> f64 {
+        let mut m = self.next_time().unwrap_or(f64::INFINITY);
+        if let Some((_, held)) = &self.chaos {
+            for (_, op) in held {
+                m = m.min(op.time().t());
+            }
+        }
+        m
+    }
+
+    /// A GVT round: returns GVT (a simulation time; every batch before it is final).
+    fn gvt_round<F: Fabric<M>>(&mut self, fabric: &F, stop: bool) -> Result<f64, Stop> {
+        let mut buf = Vec::new();
+        loop {
+            self.receive(fabric, &mut buf);
+            self.flush(fabric);
+            let local = Reduction {
+                in_flight: self.sent_ops - self.received_ops,
+                min_t: self.local_min(),
+                stop: u64::from(stop),
+            };
+            let g = fabric.reduce(self.index, local);
+            if g.stop > 0 {
+                return Err(Stop::Asked);
+            }
+            if g.in_flight == 0 {
+                self.stats.gvt_rounds += 1;
+                return Ok(g.min_t);
+            }
+        }
+    }
+
+    /// Commits every batch before `gvt`: frees its saved state and messages, and returns it
+    /// for the collector in (time, object) order.
+    fn fossil_collect(&mut self, gvt: f64) -> Vec<Committed<M::State, M::Output>> {
+        let mut out = Vec::new();
+        for lp in &mut self.lps {
+            while lp.history.front().is_some_and(|d| d.time.t() < gvt) {
+                let d = lp.history.pop_front().expect("a batch to commit");
+                self.uncommitted -= 1;
+                self.stats.committed += 1;
+                let state = match lp.history.front() {
+                    Some(next) => next.pre_state.clone(),
+                    None => lp.state.clone(),
+                };
+                let cs = &mut self.committed_stats;
+                cs.batches += 1;
+                cs.delivered += d.inputs.len() as u64;
+                cs.cancels += u64::from(d.cancel_calls);
+                for (_, kind) in &d.sent {
+                    cs.count(usize::from(*kind));
+                }
+                for uid in &d.inputs {
+                    self.entries.remove(uid);
+                }
+                out.push(Committed {
+                    time: d.time,
+                    obj: lp.id,
+                    state,
+                    output: d.output,
+                });
+            }
+            if !lp.sends.is_empty() {
+                lp.sends.retain(|_, s| s.time.t() >= gvt);
+            }
+        }
+        out.sort_by(|a, b| a.time.cmp(&b.time).then(a.obj.cmp(&b.obj)));
+        self.samples
+            .push(self.uncommitted as u64 + self.entries.len() as u64);
+        out
+    }
+
+    /// Runs this worker until GVT passes `until` (every batch at or before it committed) or
+    /// the run is stopped; hands committed batches to the fabric's collector each round.
+    pub fn run<F: Fabric<M>>(
+        &mut self,
+        model: &M,
+        fabric: &F,
+        cfg: &TwConfig,
+        until: f64,
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Result<(), Stop> {
+        let mut buf = Vec::new();
+        let mut since = 0u32;
+        let result = loop {
+            self.iteration += 1;
+            self.receive(fabric, &mut buf);
+            let window = cfg.window.map_or(f64::INFINITY, |w| self.gvt + w);
+            let mut limit = until.min(window);
+            let burst = match &mut self.chaos {
+                Some((rng, _)) => rng.gen_range(1..64u32),
+                None => 64,
+            };
+            let mut ran = 0;
+            while ran < burst {
+                if self.uncommitted > cfg.max_uncommitted {
+                    if self.uncommitted > cfg.max_uncommitted.saturating_mul(4) {
+                        break;
+                    }
+                    self.artificial_rollback();
+                    limit = limit.min(self.gvt);
+                }
+                if !self.step(model, limit) {
+                    break;
+                }
+                ran += 1;
+            }
+            self.flush(fabric);
+            since += ran.max(1);
+            if ran == 0 {
+                since = cfg.gvt_interval;
+                if self.chaos.is_none() {
+                    std::thread::yield_now();
+                }
+            }
+            let over = self.uncommitted > cfg.max_uncommitted.saturating_mul(4);
+            if over {
+                since = cfg.gvt_interval;
+            }
+            if since < cfg.gvt_interval {
+                continue;
+            }
+            since = 0;
+            let asked = stop.load(std::sync::atomic::Ordering::Relaxed);
+            match self.gvt_round(fabric, asked || over) {
+                Err(_) if over => {
+                    break Err(Stop::Memory(format!(
+                        "time warp: worker {} holds {} uncommitted batches, over 4 x its budget \
+                         of {} (raise --tw-memory or narrow --tw-window)",
+                        self.index, self.uncommitted, cfg.max_uncommitted
+                    )))
+                }
+                Err(s) => break Err(s),
+                Ok(gvt) => {
+                    self.gvt = gvt;
+                    let batches = self.fossil_collect(gvt);
+                    self.round += 1;
+                    fabric.commit(Chunk {
+                        worker: self.index,
+                        round: self.round,
+                        batches,
+                        last: None,
+                        error: None,
+                    });
+                    if gvt > until {
+                        break Ok(());
+                    }
+                }
+            }
+        };
+        let error = match &result {
+            Err(Stop::Memory(m)) => Some(m.clone()),
+            _ => None,
+        };
+        fabric.commit(Chunk {
+            worker: self.index,
+            round: u64::MAX,
+            batches: Vec::new(),
+            last: Some((
+                self.stats.clone(),
+                std::mem::take(&mut self.committed_stats),
+                self.pending_len() as u64,
+            )),
+            error,
+        });
+        result
+    }
+}
+
+/// Seeds for chaos mode from `POOLSIM_CHAOS`, when set to a number.
+pub fn chaos_from_env() -> Result<Option<u64>, String> {
+    match std::env::var("POOLSIM_CHAOS") {
+        Err(_) => Ok(None),
+        Ok(s) if s.is_empty() => Ok(None),
+        Ok(s) => s
+            .parse()
+            .map(Some)
+            .map_err(|_| format!("POOLSIM_CHAOS: expected a seed (an integer), got `{s}`")),
+    }
+}

@@ -1,0 +1,326 @@
+//! Time Warp on the threads of one process: a [`Fabric`] of shared inboxes and a barrier, and
+//! the executor that runs one thread per worker while the calling thread collects committed
+//! batches and feeds them, in order, to the sink.
+
+use super::{Chunk, Committed, Fabric, Op, Placement, Reduction, TwConfig, TwStats, Worker};
+use crate::kernel::sequential::Sink;
+use crate::kernel::{MessageStats, Model, VTime};
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Barrier, Mutex};
+
+/// The identity of [`Reduction::combine`].
+pub const NOTHING: Reduction = Reduction {
+    in_flight: 0,
+    min_t: f64::INFINITY,
+    stop: 0,
+};
+
+/// Reductions among the threads of one process: three rotating slots and a barrier.
+pub struct ThreadReduce {
+    barrier: Barrier,
+    slots: Mutex<[Reduction; 3]>,
+    calls: Vec<AtomicU64>,
+}
+
+impl ThreadReduce {
+    /// Reductions among `n` threads, numbered 0 to `n - 1`.
+    pub fn new(n: usize) -> ThreadReduce {
+        ThreadReduce {
+            barrier: Barrier::new(n),
+            slots: Mutex::new([NOTHING; 3]),
+            calls: (0..n).map(|_| AtomicU64::new(0)).collect(),
+        }
+    }
+
+    /// Combines `local` with every other thread's value of the same call.
+    pub fn reduce(&self, me: usize, local: Reduction) -> Reduction {
+        // call k adds into slot k % 3; after its barrier every thread has read slot (k - 1) % 3,
+        // which the leader then clears for call k + 2
+        let k = (self.calls[me].fetch_add(1, Ordering::Relaxed) % 3) as usize;
+        {
+            let mut s = self.slots.lock().expect("no thread panicked");
+            s[k] = s[k].combine(local);
+        }
+        let leader = self.barrier.wait().is_leader();
+        let mut s = self.slots.lock().expect("no thread panicked");
+        let r = s[k];
+        if leader {
+            s[(k + 2) % 3] = NOTHING;
+        }
+        r
+    }
+}
+
+/// Workers as threads of this process.
+pub struct ThreadFabric<M: Model> {
+    inboxes: Vec<Mutex<Vec<Op<M::Msg>>>>,
+    reduce: ThreadReduce,
+    collector: mpsc::Sender<Chunk<M::State, M::Output>>,
+}
+
+impl<M: Model> ThreadFabric<M>
+where
+    M::Msg: Send,
+{
+    /// A fabric for `n` workers whose committed chunks go to `collector`.
+    pub fn new(n: usize, collector: mpsc::Sender<Chunk<M::State, M::Output>>) -> Self {
+        ThreadFabric {
+            inboxes: (0..n).map(|_| Mutex::new(Vec::new())).collect(),
+            reduce: ThreadReduce::new(n),
+            collector,
+        }
+    }
+}
+
+impl<M: Model> Fabric<M> for ThreadFabric<M>
+where
+    M::Msg: Send,
+    M::State: Send,
+    M::Output: Send,
+{
+    fn send(&self, _from: usize, to: usize, mut ops: Vec<Op<M::Msg>>) {
+        let mut inbox = self.inboxes[to].lock().expect("no thread panicked");
+        if inbox.is_empty() {
+            std::mem::swap(&mut *inbox, &mut ops);
+        } else {
+            inbox.append(&mut ops);
+        }
+    }
+
+    fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
+        let mut inbox = self.inboxes[me].lock().expect("no thread panicked");
+        if into.is_empty() {
+            std::mem::swap(&mut *inbox, into);
+        } else {
+            into.append(&mut inbox);
+        }
+    }
+
+    fn reduce(&self, me: usize, local: Reduction) -> Reduction {
+        self.reduce.reduce(me, local)
+    }
+
+    fn commit(&self, chunk: Chunk<M::State, M::Output>) {
+        // the collector outlives the workers; if it has gone, nobody wants the output
+        let _ = self.collector.send(chunk);
+    }
+}
+
+/// Why a Time Warp run stopped early.
+#[derive(Debug)]
+pub enum TwError<E> {
+    /// The sink returned an error.
+    Sink(E),
+    /// A worker could not stay within its memory budget.
+    Memory(String),
+}
+
+/// Committed batches of one round from every worker, merged and fed to the sink.
+pub struct Collector<M: Model> {
+    states: Vec<M::State>,
+    rounds: BTreeMap<u64, Vec<Chunk<M::State, M::Output>>>,
+    next_round: u64,
+    now: Option<VTime>,
+    /// Statistics of the workers' last chunks.
+    pub stats: TwStats,
+    /// Committed message statistics (summed over runs).
+    pub messages: MessageStats,
+    /// Live messages left at the end.
+    pub pending: u64,
+}
+
+impl<M: Model> Collector<M> {
+    /// A collector starting from the objects' initial states.
+    pub fn new(states: Vec<M::State>) -> Collector<M> {
+        Collector {
+            states,
+            rounds: BTreeMap::new(),
+            next_round: 1,
+            now: None,
+            stats: TwStats::default(),
+            messages: MessageStats::default(),
+            pending: 0,
+        }
+    }
+
+    /// Takes one chunk and runs every round it completes through `sink`; the first failure
+    /// (the sink's error, or a worker's) goes to `failed`, and output stops there.
+    pub fn take<E>(
+        &mut self,
+        model: &M,
+        workers: usize,
+        chunk: Chunk<M::State, M::Output>,
+        sink: &mut Sink<'_, M, E>,
+        failed: &mut Option<TwError<E>>,
+    ) {
+        if let Some((stats, messages, pending)) = &chunk.last {
+            self.stats.add(stats);
+            self.messages.add(messages);
+            self.pending += pending;
+            if let (Some(e), None) = (&chunk.error, &failed) {
+                *failed = Some(TwError::Memory(e.clone()));
+            }
+            return;
+        }
+        self.rounds.entry(chunk.round).or_default().push(chunk);
+        while self
+            .rounds
+            .get(&self.next_round)
+            .is_some_and(|v| v.len() == workers)
+        {
+            let chunks = self.rounds.remove(&self.next_round).expect("a round");
+            self.next_round += 1;
+            if failed.is_some() {
+                continue;
+            }
+            let mut batches: Vec<Committed<M::State, M::Output>> =
+                chunks.into_iter().flat_map(|c| c.batches).collect();
+            batches.sort_by(|a, b| a.time.cmp(&b.time).then(a.obj.cmp(&b.obj)));
+            for c in batches {
+                self.states[c.obj as usize] = c.state;
+                for o in c.output {
+                    if let Err(e) = sink(model, &self.states, o) {
+                        *failed = Some(TwError::Sink(e));
+                        break;
+                    }
+                }
+                self.now = Some(c.time);
+                if failed.is_some() {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// The committed states.
+    pub fn states(&self) -> &[M::State] {
+        &self.states
+    }
+}
+
+/// The Time Warp executor on threads: the same interface as the sequential one.
+pub struct TimeWarp<M: Model> {
+    model: M,
+    workers: Vec<Worker<M>>,
+    cfg: TwConfig,
+    collector: Collector<M>,
+}
+
+impl<M> TimeWarp<M>
+where
+    M: Model + Sync,
+    M::Msg: Send,
+    M::State: Send,
+    M::Output: Send,
+{
+    /// Places the objects on `cfg.workers` workers (`worker_of[o]` for object `o`) and runs
+    /// every object's `init` at `start`.
+    pub fn new(
+        model: M,
+        states: Vec<M::State>,
+        start: VTime,
+        worker_of: &[u32],
+        cfg: TwConfig,
+    ) -> TimeWarp<M> {
+        assert_eq!(worker_of.len(), states.len(), "one worker per object");
+        let n = cfg.workers.max(1);
+        let placement = Arc::new(Placement::new(worker_of, n));
+        let mut per: Vec<Vec<(u32, M::State)>> = (0..n).map(|_| Vec::new()).collect();
+        for (o, s) in states.iter().enumerate() {
+            per[placement.worker(o as u32)].push((o as u32, s.clone()));
+        }
+        let mut workers: Vec<Worker<M>> = per
+            .into_iter()
+            .enumerate()
+            .map(|(w, st)| Worker::new(w, placement.clone(), st, cfg.chaos))
+            .collect();
+        let mut mail: Vec<Vec<Op<M::Msg>>> = (0..n).map(|_| Vec::new()).collect();
+        for w in &mut workers {
+            w.init(&model, &start);
+            for (to, ops) in w.take_outbox() {
+                mail[to].extend(ops);
+            }
+        }
+        for (w, ops) in workers.iter_mut().zip(mail) {
+            w.accept(ops);
+        }
+        TimeWarp {
+            model,
+            workers,
+            cfg,
+            collector: Collector::new(states),
+        }
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// Every object's committed state.
+    pub fn states(&self) -> &[M::State] {
+        self.collector.states()
+    }
+
+    /// Committed message statistics.
+    pub fn stats(&self) -> &MessageStats {
+        &self.collector.messages
+    }
+
+    /// Time Warp's own statistics.
+    pub fn tw_stats(&self) -> TwStats {
+        let mut s = self.collector.stats.clone();
+        s.ranks = 1;
+        s
+    }
+
+    /// Live messages waiting.
+    pub fn pending_len(&self) -> usize {
+        self.workers.iter().map(|w| w.pending_len()).sum()
+    }
+
+    /// Every worker's memory samples (uncommitted batches plus held messages) per GVT round.
+    pub fn memory_samples(&self) -> Vec<Vec<u64>> {
+        self.workers.iter().map(|w| w.samples().to_vec()).collect()
+    }
+
+    /// Runs every batch with time at most `until` optimistically on the workers; the sink sees
+    /// each output, with the committed states just after its batch, in the sequential order.
+    pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), TwError<E>> {
+        let n = self.workers.len();
+        let (tx, rx) = mpsc::channel();
+        let fabric = ThreadFabric::<M>::new(n, tx);
+        let stop = AtomicBool::new(false);
+        let TimeWarp {
+            model,
+            workers,
+            cfg,
+            collector,
+        } = self;
+        let model: &M = model;
+        let mut failed: Option<TwError<E>> = None;
+        std::thread::scope(|scope| {
+            for w in workers.iter_mut() {
+                let (fabric, stop, cfg) = (&fabric, &stop, &*cfg);
+                scope.spawn(move || w.run(model, fabric, cfg, until, stop));
+            }
+            let mut finished = 0;
+            collector.stats = TwStats::default();
+            while finished < n {
+                let chunk = rx.recv().expect("workers send a last chunk");
+                if chunk.last.is_some() {
+                    finished += 1;
+                }
+                collector.take(model, n, chunk, sink, &mut failed);
+                if failed.is_some() {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
+        });
+        match failed {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+}
