@@ -99,11 +99,21 @@ pub fn machine() -> String {
 
 /// Resident set size of this process in MiB (Linux), or 0 where unknown.
 pub fn rss_mib() -> f64 {
+    proc_status_mib("VmRSS:")
+}
+
+/// The largest resident set size this process has had, in MiB (Linux), or 0 where unknown.
+pub fn peak_rss_mib() -> f64 {
+    proc_status_mib("VmHWM:")
+}
+
+/// A size field of `/proc/self/status` in MiB.
+fn proc_status_mib(field: &str) -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
             s.lines()
-                .find(|l| l.starts_with("VmRSS:"))
+                .find(|l| l.starts_with(field))
                 .and_then(|l| l.split_whitespace().nth(1))
                 .and_then(|kb| kb.parse::<f64>().ok())
         })

@@ -5,6 +5,7 @@
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use poolsim::engine::{Event, Observer, RunError, World};
+use poolsim::kernel::time_warp::{self, TwConfig};
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};
 use poolsim::run::{execute, EngineKind, RunConfig, SectorChoice};
@@ -61,7 +62,7 @@ impl GenArgs {
 struct RunArgs {
     /// A built-in scenario name (see `poolsim scenarios`) or a TOML file.
     scenario: String,
-    /// event-list, time-step or objects (time-warp comes with its issue).
+    /// event-list, time-step, objects or time-warp.
     #[arg(long, default_value = "event-list")]
     engine: String,
     /// Sector layout: none, auto, N or NxM (sectored engines only).
@@ -84,9 +85,18 @@ struct RunArgs {
     /// Check invariants at every event; a violation stops the run with exit status 1.
     #[arg(long)]
     check: bool,
-    /// Worker threads (time-warp engine).
+    /// Worker threads (time-warp engine; default: this machine's cores).
     #[arg(long)]
     workers: Option<usize>,
+    /// Time Warp's optimism window: no batch later than GVT plus this (simulation time).
+    #[arg(long = "tw-window")]
+    tw_window: Option<f64>,
+    /// Time Warp's memory budget: uncommitted batches per worker.
+    #[arg(long = "tw-memory")]
+    tw_memory: Option<usize>,
+    /// Batches a Time Warp worker runs between GVT rounds.
+    #[arg(long = "gvt-interval")]
+    gvt_interval: Option<u32>,
     /// Delay of NewVelocity messages (objects engines).
     #[arg(long = "newvelocity-delay")]
     newvelocity_delay: Option<String>,
@@ -215,6 +225,9 @@ fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
         json: a.json,
         check: a.check,
         workers: None,
+        tw_window: None,
+        tw_memory: None,
+        gvt_interval: None,
         newvelocity_delay: a.newvelocity_delay.clone(),
         dt: a.dt,
         quiet: true,
@@ -505,13 +518,64 @@ fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
                 }
             }
         }
-        "time-warp" => Err(usage(
-            "--engine: `time-warp` is not built yet; available: event-list, time-step, objects",
-        )),
+        "time-warp" => {
+            let delay = nv_delay(a.newvelocity_delay.as_deref(), scenario)?;
+            let sectors = sector_choice(a.sectors.as_deref(), scenario)?;
+            if let Some(choice) = sectors {
+                if delay != NvDelay::Exact {
+                    return Err(usage(
+                        "--newvelocity-delay: the thesis' delay runs on non-sectored tables \
+                         only (--sectors none)",
+                    ));
+                }
+                poolsim::run::sector_layout(scenario, choice)
+                    .map_err(|e| usage(format!("--sectors: {e}")))?;
+            }
+            Ok(EngineKind::TimeWarp {
+                tw: tw_config(a)?,
+                delay,
+                sectors,
+            })
+        }
         other => Err(usage(format!(
-            "--engine: unknown engine `{other}`; available: event-list, time-step, objects"
+            "--engine: unknown engine `{other}`; available: event-list, time-step, objects, \
+             time-warp"
         ))),
     }
+}
+
+/// Time Warp's settings from the flags and `POOLSIM_CHAOS`.
+fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
+    let mut tw = TwConfig {
+        workers: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        chaos: time_warp::chaos_from_env().map_err(usage)?,
+        ..TwConfig::default()
+    };
+    if let Some(w) = a.workers {
+        if !(1..=1024).contains(&w) {
+            return Err(usage(format!("--workers: must be 1 to 1024, got {w}")));
+        }
+        tw.workers = w;
+    }
+    if let Some(w) = a.tw_window {
+        if !(w.is_finite() && w > 0.0) {
+            return Err(usage(format!("--tw-window: must be a positive number, got {w}")));
+        }
+        tw.window = Some(w);
+    }
+    if let Some(m) = a.tw_memory {
+        if m < 16 {
+            return Err(usage(format!("--tw-memory: must be at least 16 batches, got {m}")));
+        }
+        tw.max_uncommitted = m;
+    }
+    if let Some(g) = a.gvt_interval {
+        if g == 0 {
+            return Err(usage("--gvt-interval: must be at least 1"));
+        }
+        tw.gvt_interval = g;
+    }
+    Ok(tw)
 }
 
 fn run(a: &RunArgs) -> Result<(), Failure> {
@@ -519,20 +583,30 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
     let engine = engine_of(a, &scenario)?;
     let objects = matches!(
         engine,
-        EngineKind::Objects { .. } | EngineKind::Sectored { .. }
+        EngineKind::Objects { .. } | EngineKind::Sectored { .. } | EngineKind::TimeWarp { .. }
     );
+    let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
     for (flag, given) in [
         ("--sectors", a.sectors.is_some() && !objects),
         (
             "--newvelocity-delay",
             a.newvelocity_delay.is_some() && !objects,
         ),
-        ("--workers", a.workers.is_some()),
     ] {
         if given {
             return Err(usage(format!(
                 "{flag}: only the objects and time-warp engines take it"
             )));
+        }
+    }
+    for (flag, given) in [
+        ("--workers", a.workers.is_some()),
+        ("--tw-window", a.tw_window.is_some()),
+        ("--tw-memory", a.tw_memory.is_some()),
+        ("--gvt-interval", a.gvt_interval.is_some()),
+    ] {
+        if given && !time_warp {
+            return Err(usage(format!("{flag}: only the time-warp engine takes it")));
         }
     }
     let until = a.until.unwrap_or(scenario.until);
@@ -715,6 +789,9 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
         json: false,
         check: a.check,
         workers: None,
+        tw_window: None,
+        tw_memory: None,
+        gvt_interval: None,
         newvelocity_delay: a.newvelocity_delay.clone(),
         dt: None,
         quiet: true,

@@ -8,6 +8,7 @@ use crate::engine::event_list::{self, EventList};
 use crate::engine::objects::Objects;
 use crate::engine::time_step::{self, TimeStep};
 use crate::engine::{BallState, Event, Frame, Observer, Outcome, RunError, Span, Table, World};
+use crate::kernel::time_warp::{TwConfig, TwStats};
 use crate::model::pool::NvDelay;
 use crate::model::sectored::Layout;
 use crate::output::{digest, events_json};
@@ -37,6 +38,15 @@ pub enum EngineKind {
     Sectored {
         /// How the table is cut into sectors.
         sectors: SectorChoice,
+    },
+    /// The objects run optimistically in parallel by Time Warp, plain or sectored.
+    TimeWarp {
+        /// Workers, chaos, throttles.
+        tw: TwConfig,
+        /// How NewVelocity messages travel (plain objects).
+        delay: NvDelay,
+        /// How the table is cut into sectors; `None`: not sectored.
+        sectors: Option<SectorChoice>,
     },
 }
 
@@ -81,6 +91,7 @@ impl EngineKind {
             EngineKind::EventList => "event-list",
             EngineKind::TimeStep { .. } => "time-step",
             EngineKind::Objects { .. } | EngineKind::Sectored { .. } => "objects",
+            EngineKind::TimeWarp { .. } => "time-warp",
         }
     }
 }
@@ -158,6 +169,7 @@ pub fn execute(
         .check
         .then(|| Checker::new(&initial, table.is_elastic()));
     let mut sinks = Sinks { checker, user: obs };
+    let mut time_warp: Option<TwStats> = None;
     let outcome = match cfg.engine {
         EngineKind::EventList => {
             let opts = event_list::Options {
@@ -189,6 +201,23 @@ pub fn execute(
             let mut e = Objects::sectored(scenario, layout, cfg.span);
             e.run(cfg.until, &mut sinks)?
         }
+        EngineKind::TimeWarp { tw, delay, sectors } => {
+            let mut e = match sectors {
+                None => Objects::plain_on(scenario, delay, cfg.span, Some(tw)),
+                Some(_) if cfg.span.frame_time.is_some() => {
+                    return Err(RunError::Input(
+                        "the sectored engine draws no frames itself (poolsim render does)".into(),
+                    ))
+                }
+                Some(choice) => {
+                    let layout = sector_layout(scenario, choice).map_err(RunError::Input)?;
+                    Objects::sectored_on(scenario, layout, cfg.span, Some(tw))
+                }
+            };
+            let out = e.run(cfg.until, &mut sinks)?;
+            time_warp = e.tw_stats();
+            out
+        }
     };
     let wall = start.elapsed().as_secs_f64();
     let (e0, _) = energies(&initial);
@@ -218,12 +247,29 @@ pub fn execute(
         "checked": cfg.check,
         "engine_stats": stats,
     });
+    let mut summary = summary;
+    if let Some(tw) = &time_warp {
+        summary["time_warp"] = time_warp_json(tw);
+    }
     Ok(Report {
         outcome,
         wall_seconds: wall,
         max_energy_drift: max_drift,
         summary,
     })
+}
+
+/// The summary's `time_warp` object.
+pub fn time_warp_json(tw: &TwStats) -> Value {
+    let mut v = serde_json::to_value(tw).expect("plain numbers");
+    v["efficiency"] = json!(tw.efficiency());
+    v["remote_fraction"] = json!(if tw.messages > 0 {
+        tw.remote_messages as f64 / tw.messages as f64
+    } else {
+        0.0
+    });
+    v["peak_rss_mib"] = json!(crate::bench::peak_rss_mib());
+    v
 }
 
 /// The thesis' message types that count towards its totals (table 5).

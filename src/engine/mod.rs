@@ -9,6 +9,7 @@ pub mod calendar;
 pub mod event_list;
 pub mod grid;
 pub mod objects;
+pub mod partition;
 pub mod time_step;
 
 use crate::geometry::{Trajectory, Vec2};
@@ -362,6 +363,8 @@ pub enum RunError {
     Output(String),
     /// The run was asked for something the input does not allow (a bad sector layout).
     Input(String),
+    /// Time Warp failed: out of its memory budget, or a model bug committed.
+    TimeWarp(String),
 }
 
 impl fmt::Display for RunError {
@@ -375,6 +378,7 @@ impl fmt::Display for RunError {
             ),
             RunError::Output(m) => write!(f, "output failed: {m}"),
             RunError::Input(m) => write!(f, "{m}"),
+            RunError::TimeWarp(m) => write!(f, "{m}"),
         }
     }
 }

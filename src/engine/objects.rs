@@ -1,9 +1,13 @@
 //! The objects engine (thesis fig. 3 and 14): the pool objects of [`crate::model::pool`], or the
-//! sectored ones of [`crate::model::sectored`], run by the sequential kernel executor. With zero
-//! NewVelocity delay it executes exactly the event-list engine's physical events.
+//! sectored ones of [`crate::model::sectored`], run by the sequential kernel executor or by Time
+//! Warp. With zero NewVelocity delay it executes exactly the event-list engine's physical events.
 
-use super::{BallState, EventCounts, Frame, Observer, Outcome, RunError, Span, Table, World};
-use crate::kernel::sequential::Sequential;
+use super::{
+    partition, BallState, EventCounts, Frame, Observer, Outcome, RunError, Span, Table, World,
+};
+use crate::kernel::sequential::{Sequential, Sink};
+use crate::kernel::time_warp::threads::{TimeWarp, TwError};
+use crate::kernel::time_warp::{TwConfig, TwStats};
 use crate::kernel::{MessageStats, Model, VTime};
 use crate::model::pool::{BallInfo, NvDelay, Pool, PoolOutput, PoolState};
 use crate::model::sectored::{Layout, SecState, Sectored};
@@ -13,9 +17,87 @@ use crate::vtime::Key;
 /// The objects engine over one scenario: plain or sectored.
 pub enum Objects {
     /// Every ball tells every object (thesis fig. 3).
-    Plain(Sequential<Pool>),
+    Plain(Exec<Pool>),
     /// Sectors relay (thesis fig. 14).
-    Sectored(Sequential<Sectored>),
+    Sectored(Exec<Sectored>),
+}
+
+/// The executor that runs the objects.
+pub enum Exec<M: Model> {
+    /// One batch at a time, in order.
+    Sequential(Sequential<M>),
+    /// Optimistically in parallel.
+    TimeWarp(Box<TimeWarp<M>>),
+}
+
+impl<M> Exec<M>
+where
+    M: Model + Sync,
+    M::Msg: Send,
+    M::State: Send,
+    M::Output: Send,
+{
+    /// The sequential executor, or Time Warp with `tw` and the objects' workers `worker_of`.
+    fn new(model: M, states: Vec<M::State>, start: f64, tw: Option<(TwConfig, Vec<u32>)>) -> Self {
+        let start = VTime::at(Key::start(start));
+        match tw {
+            None => Exec::Sequential(Sequential::new(model, states, start)),
+            Some((cfg, worker_of)) => Exec::TimeWarp(Box::new(TimeWarp::new(
+                model, states, start, &worker_of, cfg,
+            ))),
+        }
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        match self {
+            Exec::Sequential(e) => e.model(),
+            Exec::TimeWarp(e) => e.model(),
+        }
+    }
+
+    /// The objects' (committed) states.
+    pub fn states(&self) -> &[M::State] {
+        match self {
+            Exec::Sequential(e) => e.states(),
+            Exec::TimeWarp(e) => e.states(),
+        }
+    }
+
+    /// Committed message statistics.
+    pub fn stats(&self) -> &MessageStats {
+        match self {
+            Exec::Sequential(e) => e.stats(),
+            Exec::TimeWarp(e) => e.stats(),
+        }
+    }
+
+    /// Messages waiting.
+    pub fn pending_len(&self) -> usize {
+        match self {
+            Exec::Sequential(e) => e.pending_len(),
+            Exec::TimeWarp(e) => e.pending_len(),
+        }
+    }
+
+    /// Time Warp's statistics, under Time Warp.
+    pub fn tw_stats(&self) -> Option<TwStats> {
+        match self {
+            Exec::Sequential(_) => None,
+            Exec::TimeWarp(e) => Some(e.tw_stats()),
+        }
+    }
+
+    /// Runs every batch up to `until`, each output to `sink`.
+    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, RunError>) -> Result<(), RunError> {
+        match self {
+            Exec::Sequential(e) => e.run(until, sink),
+            Exec::TimeWarp(e) => e.run(until, sink).map_err(|e| match e {
+                TwError::Sink(e) => e,
+                TwError::Failed(m) => RunError::TimeWarp(m),
+            }),
+        }
+    }
 }
 
 /// The ball part of an object's state.
@@ -75,24 +157,36 @@ impl<S: BallOf> World for View<'_, S> {
 
 impl Objects {
     /// Sets the plain objects up at `span.start` (their `init` sends the first NewVelocity
-    /// messages).
+    /// messages), sequential.
     pub fn new(s: &Scenario, delay: NvDelay, span: Span) -> Objects {
-        let (model, states) = Pool::new(s, delay, span);
-        Objects::Plain(Sequential::new(
-            model,
-            states,
-            VTime::at(Key::start(span.start)),
-        ))
+        Objects::plain_on(s, delay, span, None)
     }
 
-    /// Sets the sectored objects up at `span.start` over `layout`.
+    /// Sets the plain objects up, sequential or (with `tw`) under Time Warp, the balls in
+    /// strips of the table.
+    pub fn plain_on(s: &Scenario, delay: NvDelay, span: Span, tw: Option<TwConfig>) -> Objects {
+        let (model, states) = Pool::new(s, delay, span);
+        let tw = tw.map(|c| {
+            let w = partition::plain(s, c.workers);
+            (c, w)
+        });
+        Objects::Plain(Exec::new(model, states, span.start, tw))
+    }
+
+    /// Sets the sectored objects up at `span.start` over `layout`, sequential.
     pub fn sectored(s: &Scenario, layout: Layout, span: Span) -> Objects {
+        Objects::sectored_on(s, layout, span, None)
+    }
+
+    /// Sets the sectored objects up, sequential or (with `tw`) under Time Warp, each sector and
+    /// the balls that start in it on one worker.
+    pub fn sectored_on(s: &Scenario, layout: Layout, span: Span, tw: Option<TwConfig>) -> Objects {
+        let tw = tw.map(|c| {
+            let w = partition::sectored(s, &layout, c.workers);
+            (c, w)
+        });
         let (model, states) = Sectored::new(s, layout, span);
-        Objects::Sectored(Sequential::new(
-            model,
-            states,
-            VTime::at(Key::start(span.start)),
-        ))
+        Objects::Sectored(Exec::new(model, states, span.start, tw))
     }
 
     /// Message statistics so far.
@@ -100,6 +194,14 @@ impl Objects {
         match self {
             Objects::Plain(e) => e.stats(),
             Objects::Sectored(e) => e.stats(),
+        }
+    }
+
+    /// Time Warp's statistics, when it runs the objects.
+    pub fn tw_stats(&self) -> Option<TwStats> {
+        match self {
+            Objects::Plain(e) => e.tw_stats(),
+            Objects::Sectored(e) => e.tw_stats(),
         }
     }
 
@@ -124,9 +226,12 @@ impl Objects {
 }
 
 /// The end of a run of either model: balls at `until` and the message counts.
-fn outcome<M: Model>(e: &Sequential<M>, table: &Table, until: f64, counts: EventCounts) -> Outcome
+fn outcome<M>(e: &Exec<M>, table: &Table, until: f64, counts: EventCounts) -> Outcome
 where
-    M::State: BallOf,
+    M: Model + Sync,
+    M::Msg: Send,
+    M::State: Send + BallOf,
+    M::Output: Send,
 {
     let view = View {
         table,
@@ -166,7 +271,7 @@ where
 
 /// Runs the plain objects, assembling the Projector's frames.
 fn run_plain(
-    exec: &mut Sequential<Pool>,
+    exec: &mut Exec<Pool>,
     until: f64,
     obs: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {

@@ -165,6 +165,10 @@ pub struct Ctx<'a, M: Model + ?Sized> {
     pub cancelled: Vec<Handle>,
     /// Output this batch produced.
     pub output: Vec<M::Output>,
+    /// Set by an optimistic executor: a batch may run on a state that a rollback will undo.
+    speculative: bool,
+    /// A send into the past this speculative batch tried (and that was dropped).
+    pub into_past: Option<String>,
 }
 
 impl<'a, M: Model + ?Sized> Ctx<'a, M> {
@@ -178,6 +182,18 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             sent: Vec::new(),
             cancelled: Vec::new(),
             output: Vec::new(),
+            speculative: false,
+            into_past: None,
+        }
+    }
+
+    /// A context for a batch that may run on an inconsistent state (Time Warp): a send into
+    /// the past is dropped and recorded in `into_past` instead of panicking, for the executor
+    /// to report if the batch is ever committed.
+    pub fn speculative(model: &'a M, now: VTime, me: u32, seq: &'a mut u64) -> Ctx<'a, M> {
+        Ctx {
+            speculative: true,
+            ..Ctx::new(model, now, me, seq)
         }
     }
 
@@ -189,15 +205,22 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     /// Sends `msg` to `to` at virtual time `time`, which must not be before now.
     ///
     /// # Panics
-    /// If `time` is before now: a model bug, a message into the past.
+    /// If `time` is not after now: a model bug, a message into the past (in a speculative
+    /// batch the message is dropped and the batch marked instead).
     pub fn send_at(&mut self, to: u32, time: VTime, msg: M::Msg) -> Handle {
-        assert!(
-            time > self.now,
-            "object {} sent a message into the past: {:?} at {:?}",
-            self.me,
-            time,
-            self.now
-        );
+        if time <= self.now {
+            let what = format!(
+                "object {} sent a message into the past: {:?} at {:?}",
+                self.me, time, self.now
+            );
+            assert!(self.speculative, "{what}");
+            *self.seq += 1;
+            self.into_past.get_or_insert(what);
+            return Handle {
+                from: self.me,
+                seq: *self.seq,
+            };
+        }
         *self.seq += 1;
         let env = Envelope {
             from: self.me,

@@ -338,6 +338,13 @@ fn chunked(
             let layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
             Objects::sectored(scenario, layout, Default::default())
         }
+        EngineKind::TimeWarp { tw, delay, sectors } => match sectors {
+            None => Objects::plain_on(scenario, delay, Span::default(), Some(tw)),
+            Some(choice) => {
+                let layout = sector_layout(scenario, choice).map_err(RunError::Input)?;
+                Objects::sectored_on(scenario, layout, Span::default(), Some(tw))
+            }
+        },
         EngineKind::EventList | EngineKind::TimeStep { .. } => return Ok(None),
     };
     let mut counts = EventCounts::default();

@@ -43,7 +43,7 @@ use std::cmp::Ordering;
 use std::collections::{BinaryHeap, VecDeque};
 
 /// Time Warp's settings.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TwConfig {
     /// Worker threads (per rank under MPI).
     pub workers: usize,
@@ -329,6 +329,8 @@ struct Done<M: Model> {
     cancels: Vec<Sent>,
     cancel_calls: u32,
     output: Vec<M::Output>,
+    /// A send into the past it tried: harmless if rolled back, a model bug if committed.
+    into_past: Option<String>,
 }
 
 /// One object (a logical process) on its worker.
@@ -416,6 +418,8 @@ pub struct Worker<M: Model> {
     committed_stats: MessageStats,
     /// Memory samples (uncommitted batches plus entries) after each GVT round.
     samples: Vec<u64>,
+    /// A failure found while committing; the run stops at the next GVT round.
+    fault: Option<String>,
 }
 
 /// Why a worker stopped early.
@@ -423,8 +427,8 @@ pub struct Worker<M: Model> {
 pub enum Stop {
     /// Another worker or the collector asked to stop.
     Asked,
-    /// This worker could not stay within its memory budget.
-    Memory(String),
+    /// This worker failed: out of its memory budget, or a model bug committed.
+    Failed(String),
 }
 
 impl<M: Model> Worker<M> {
@@ -473,6 +477,7 @@ impl<M: Model> Worker<M> {
             },
             committed_stats: MessageStats::default(),
             samples: Vec::new(),
+            fault: None,
         }
     }
 
@@ -702,9 +707,10 @@ impl<M: Model> Worker<M> {
         );
         let pre_state = lp.state.clone();
         let pre_seq = lp.seq;
-        let mut ctx = Ctx::new(model, time.clone(), to, &mut lp.seq);
+        let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq);
         model.handle(&mut ctx, to, &mut lp.state, &batch);
         let (sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
+        let into_past = ctx.into_past;
         let mut ops = Vec::with_capacity(sent.len());
         let mut sent_recs = Vec::with_capacity(sent.len());
         for p in sent {
@@ -744,6 +750,7 @@ impl<M: Model> Worker<M> {
             cancels,
             cancel_calls: cancelled.len() as u32,
             output,
+            into_past,
         });
         self.uncommitted += 1;
         self.stats.processed += 1;
@@ -851,6 +858,9 @@ impl<M: Model> Worker<M> {
         for lp in &mut self.lps {
             while lp.history.front().is_some_and(|d| d.time.t() < gvt) {
                 let d = lp.history.pop_front().expect("a batch to commit");
+                if let Some(what) = d.into_past {
+                    self.fault.get_or_insert(format!("model bug in a committed batch: {what}"));
+                }
                 self.uncommitted -= 1;
                 self.stats.committed += 1;
                 let state = match lp.history.front() {
@@ -928,7 +938,7 @@ impl<M: Model> Worker<M> {
                 }
             }
             let over = self.uncommitted > cfg.max_uncommitted.saturating_mul(4);
-            if over {
+            if over || self.fault.is_some() {
                 since = cfg.gvt_interval;
             }
             if since < cfg.gvt_interval {
@@ -936,9 +946,12 @@ impl<M: Model> Worker<M> {
             }
             since = 0;
             let asked = stop.load(std::sync::atomic::Ordering::Relaxed);
-            match self.gvt_round(fabric, asked || over) {
+            match self.gvt_round(fabric, asked || over || self.fault.is_some()) {
+                Err(_) if self.fault.is_some() => {
+                    break Err(Stop::Failed(self.fault.take().expect("a fault")))
+                }
                 Err(_) if over => {
-                    break Err(Stop::Memory(format!(
+                    break Err(Stop::Failed(format!(
                         "time warp: worker {} holds {} uncommitted batches, over 4 x its budget \
                          of {} (raise --tw-memory or narrow --tw-window)",
                         self.index, self.uncommitted, cfg.max_uncommitted
@@ -963,7 +976,7 @@ impl<M: Model> Worker<M> {
             }
         };
         let error = match &result {
-            Err(Stop::Memory(m)) => Some(m.clone()),
+            Err(Stop::Failed(m)) => Some(m.clone()),
             _ => None,
         };
         fabric.commit(Chunk {

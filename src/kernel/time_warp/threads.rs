@@ -112,8 +112,8 @@ where
 pub enum TwError<E> {
     /// The sink returned an error.
     Sink(E),
-    /// A worker could not stay within its memory budget.
-    Memory(String),
+    /// A worker failed: out of its memory budget, or a model bug committed.
+    Failed(String),
 }
 
 /// Committed batches of one round from every worker, merged and fed to the sink.
@@ -159,7 +159,7 @@ impl<M: Model> Collector<M> {
             self.messages.add(messages);
             self.pending += pending;
             if let (Some(e), None) = (&chunk.error, &failed) {
-                *failed = Some(TwError::Memory(e.clone()));
+                *failed = Some(TwError::Failed(e.clone()));
             }
             return;
         }
