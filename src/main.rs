@@ -559,13 +559,17 @@ fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
     }
     if let Some(w) = a.tw_window {
         if !(w.is_finite() && w > 0.0) {
-            return Err(usage(format!("--tw-window: must be a positive number, got {w}")));
+            return Err(usage(format!(
+                "--tw-window: must be a positive number, got {w}"
+            )));
         }
         tw.window = Some(w);
     }
     if let Some(m) = a.tw_memory {
         if m < 16 {
-            return Err(usage(format!("--tw-memory: must be at least 16 batches, got {m}")));
+            return Err(usage(format!(
+                "--tw-memory: must be at least 16 batches, got {m}"
+            )));
         }
         tw.max_uncommitted = m;
     }

@@ -167,7 +167,8 @@ impl Objects {
     pub fn plain_on(s: &Scenario, delay: NvDelay, span: Span, tw: Option<TwConfig>) -> Objects {
         let (model, states) = Pool::new(s, delay, span);
         let tw = tw.map(|c| {
-            let w = partition::plain(s, c.workers);
+            let mut w = partition::plain(s, c.workers);
+            w.resize(states.len(), 0);
             (c, w)
         });
         Objects::Plain(Exec::new(model, states, span.start, tw))

@@ -54,15 +54,14 @@ fn fixed_points(table: &Table) -> impl Iterator<Item = Vec2> + '_ {
         .chain(table.corners.iter().map(|c| c.0))
 }
 
-/// Workers of the plain objects (balls, fixed objects, the Projector last): strips of equal
-/// ball counts; the Projector runs on worker 0.
+/// Workers of the plain objects (balls, then fixed objects) in strips of equal ball counts;
+/// objects after them (the Projector) run on worker 0.
 pub fn plain(s: &Scenario, workers: usize) -> Vec<u32> {
     let table = Table::new(s);
     let points: Vec<(Vec2, f64)> = s.balls.iter().map(|b| (b.position, 1.0)).collect();
     let strips = Strips::new(&table, &points, workers);
     let mut out: Vec<u32> = points.iter().map(|p| strips.of(p.0)).collect();
     out.extend(fixed_points(&table).map(|p| strips.of(p)));
-    out.push(0);
     out
 }
 
@@ -73,7 +72,13 @@ pub fn sectored(s: &Scenario, layout: &Layout, workers: usize) -> Vec<u32> {
     let home: Vec<u32> = s
         .balls
         .iter()
-        .map(|b| layout.touching(b.position, 0.0).first().copied().unwrap_or(0))
+        .map(|b| {
+            layout
+                .touching(b.position, 0.0)
+                .first()
+                .copied()
+                .unwrap_or(0)
+        })
         .collect();
     let mut load = vec![1.0; layout.polys.len()];
     for &k in &home {
@@ -110,7 +115,7 @@ mod tests {
         let s = builtin::build("gas", &p).unwrap();
         for workers in 1..=4 {
             let w = plain(&s, workers);
-            assert_eq!(w.len(), s.balls.len() + Table::new(&s).n_fixed() as usize + 1);
+            assert_eq!(w.len(), s.balls.len() + Table::new(&s).n_fixed() as usize);
             let mut counts = vec![0; workers];
             for &k in &w[..64] {
                 counts[k as usize] += 1;

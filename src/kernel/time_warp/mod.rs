@@ -762,10 +762,14 @@ impl<M: Model> Worker<M> {
         true
     }
 
-    /// Rolls back every object that ran past the next message here, to free saved states.
+    /// Rolls back every object that ran past the next message here, to free saved states, when
+    /// that message is later than GVT's instant.
     fn artificial_rollback(&mut self) {
-        let Some(top) = self.heap.peek() else { return };
-        let t = top.time.clone();
+        // batches of GVT's own instant cannot be committed yet: they are needed, not optimism
+        if self.next_time().is_none_or(|t| t <= self.gvt) {
+            return;
+        }
+        let t = self.heap.peek().expect("a valid top").time.clone();
         for li in 0..self.lps.len() {
             if self.lps[li].last_time().is_some_and(|x| *x >= t) {
                 self.stats.artificial_rollbacks += 1;
@@ -859,7 +863,8 @@ impl<M: Model> Worker<M> {
             while lp.history.front().is_some_and(|d| d.time.t() < gvt) {
                 let d = lp.history.pop_front().expect("a batch to commit");
                 if let Some(what) = d.into_past {
-                    self.fault.get_or_insert(format!("model bug in a committed batch: {what}"));
+                    self.fault
+                        .get_or_insert(format!("model bug in a committed batch: {what}"));
                 }
                 self.uncommitted -= 1;
                 self.stats.committed += 1;

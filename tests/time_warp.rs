@@ -1,0 +1,151 @@
+//! Time Warp against the sequential objects engine: for any number of workers, with and
+//! without chaos (deliveries delayed and reordered to force rollbacks), the same physical
+//! events in the same order, the same message counts and the same final state, bit for bit.
+
+use poolsim::kernel::time_warp::TwConfig;
+use poolsim::model::pool::NvDelay;
+use poolsim::output::{TraceLine, TraceRecorder};
+use poolsim::run::{execute, EngineKind, RunConfig, SectorChoice};
+use poolsim::scenario::{builtin, load, Scenario};
+
+struct Run {
+    trace: Vec<TraceLine>,
+    summary: serde_json::Value,
+}
+
+fn run(s: &Scenario, engine: EngineKind) -> Run {
+    let mut rec = TraceRecorder::default();
+    let cfg = RunConfig {
+        engine,
+        until: s.until,
+        check: true,
+        span: Default::default(),
+    };
+    let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
+    Run {
+        trace: rec.lines,
+        summary: report.summary,
+    }
+}
+
+fn sequential(sectors: Option<SectorChoice>) -> EngineKind {
+    match sectors {
+        None => EngineKind::Objects {
+            delay: NvDelay::Exact,
+        },
+        Some(sectors) => EngineKind::Sectored { sectors },
+    }
+}
+
+fn time_warp(sectors: Option<SectorChoice>, workers: usize, chaos: Option<u64>) -> EngineKind {
+    EngineKind::TimeWarp {
+        tw: TwConfig {
+            workers,
+            chaos,
+            gvt_interval: 256,
+            ..TwConfig::default()
+        },
+        delay: NvDelay::Exact,
+        sectors,
+    }
+}
+
+/// Runs `s` sequentially and under Time Warp on 1, 2 and 3 workers, with and without chaos.
+fn assert_same(s: &Scenario, sectors: Option<SectorChoice>) -> Vec<serde_json::Value> {
+    let want = run(s, sequential(sectors));
+    let mut stats = Vec::new();
+    for workers in [1, 2, 3] {
+        for chaos in [None, Some(workers as u64 * 31 + 5)] {
+            let got = run(s, time_warp(sectors, workers, chaos));
+            let what = format!("{} {sectors:?} workers {workers} chaos {chaos:?}", s.name);
+            assert_eq!(got.trace, want.trace, "{what}: traces differ");
+            for field in ["final_state_digest", "messages", "events"] {
+                assert_eq!(got.summary[field], want.summary[field], "{what}: {field}");
+            }
+            let tw = &got.summary["time_warp"];
+            assert_eq!(tw["workers"], workers, "{what}");
+            assert_eq!(
+                tw["committed"].as_f64(),
+                want.summary["engine_stats"]["batches"].as_f64(),
+                "{what}: every sequential batch committed once"
+            );
+            stats.push(tw.clone());
+        }
+    }
+    stats
+}
+
+fn gas(balls: usize, seed: u64) -> Scenario {
+    let p = builtin::Params {
+        balls: Some(balls),
+        seed: Some(seed),
+        ..Default::default()
+    };
+    builtin::build("gas", &p).unwrap()
+}
+
+#[test]
+fn sectored_gas_is_exact_and_rolls_back() {
+    let stats = assert_same(&gas(64, 3), Some(SectorChoice::Grid(4, 4)));
+    // chaos on more than one worker must actually force rollbacks
+    let rolled: u64 = stats
+        .iter()
+        .map(|t| t["rolled_back"].as_u64().unwrap())
+        .sum();
+    assert!(rolled > 0, "no rollback at all: {stats:?}");
+    for t in &stats {
+        let (processed, committed) = (t["processed"].as_u64(), t["committed"].as_u64());
+        assert!(processed >= committed);
+    }
+}
+
+#[test]
+fn plain_gas_is_exact() {
+    assert_same(&gas(16, 5), None);
+}
+
+#[test]
+fn the_break_and_the_cradle_are_exact() {
+    for name in ["pool", "cradle", "plate1"] {
+        let s = builtin::build(name, &builtin::Params::default()).unwrap();
+        assert_same(&s, None);
+        assert_same(&s, Some(SectorChoice::Grid(2, 2)));
+    }
+}
+
+#[test]
+fn every_hard_case_is_exact() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let s = load(path.to_str().unwrap(), &builtin::Params::default()).unwrap();
+            assert_same(&s, None);
+            assert_same(&s, Some(SectorChoice::Grid(3, 3)));
+            n += 1;
+        }
+    }
+    assert!(n >= 10, "only {n} hard cases found");
+}
+
+#[test]
+fn a_tight_memory_budget_rolls_back_and_stays_exact() {
+    let s = gas(64, 8);
+    let want = run(&s, sequential(Some(SectorChoice::Grid(4, 4))));
+    let engine = EngineKind::TimeWarp {
+        tw: TwConfig {
+            workers: 2,
+            chaos: Some(3),
+            gvt_interval: 4096,
+            max_uncommitted: 64,
+            window: Some(0.05),
+        },
+        delay: NvDelay::Exact,
+        sectors: Some(SectorChoice::Grid(4, 4)),
+    };
+    let got = run(&s, engine);
+    assert_eq!(got.trace, want.trace);
+    let tw = &got.summary["time_warp"];
+    assert!(tw["artificial_rollbacks"].as_u64().unwrap() > 0, "{tw}");
+}
