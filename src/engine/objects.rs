@@ -25,7 +25,7 @@ pub enum Objects {
 /// The executor that runs the objects.
 pub enum Exec<M: Model> {
     /// One batch at a time, in order.
-    Sequential(Sequential<M>),
+    Sequential(Box<Sequential<M>>),
     /// Optimistically in parallel.
     TimeWarp(Box<TimeWarp<M>>),
 }
@@ -41,7 +41,7 @@ where
     fn new(model: M, states: Vec<M::State>, start: f64, tw: Option<(TwConfig, Vec<u32>)>) -> Self {
         let start = VTime::at(Key::start(start));
         match tw {
-            None => Exec::Sequential(Sequential::new(model, states, start)),
+            None => Exec::Sequential(Box::new(Sequential::new(model, states, start))),
             Some((cfg, worker_of)) => Exec::TimeWarp(Box::new(TimeWarp::new(
                 model, states, start, &worker_of, cfg,
             ))),

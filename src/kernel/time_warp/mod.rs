@@ -397,6 +397,13 @@ impl Placement {
     }
 }
 
+/// Chaos mode's state.
+struct Chaos<Msg> {
+    rng: ChaCha8Rng,
+    /// Ops held back, with the iteration that releases each.
+    held: Vec<(u64, Op<Msg>)>,
+}
+
 /// One worker: its objects, its messages, its outboxes.
 pub struct Worker<M: Model> {
     index: usize,
@@ -406,8 +413,8 @@ pub struct Worker<M: Model> {
     heap: BinaryHeap<Item>,
     local_ops: Vec<Op<M::Msg>>,
     outbox: Vec<Vec<Op<M::Msg>>>,
-    /// Chaos mode: its random stream and the ops it holds back, with their release iteration.
-    chaos: Option<(ChaCha8Rng, Vec<(u64, Op<M::Msg>)>)>,
+    /// Chaos mode: its random stream and the ops it holds back.
+    chaos: Option<Chaos<M::Msg>>,
     iteration: u64,
     sent_ops: i64,
     received_ops: i64,
@@ -458,11 +465,9 @@ impl<M: Model> Worker<M> {
             heap: BinaryHeap::new(),
             local_ops: Vec::new(),
             outbox: (0..workers).map(|_| Vec::new()).collect(),
-            chaos: chaos.map(|s| {
-                (
-                    ChaCha8Rng::seed_from_u64(s ^ (index as u64).wrapping_mul(0x9e37_79b9)),
-                    Vec::new(),
-                )
+            chaos: chaos.map(|s| Chaos {
+                rng: ChaCha8Rng::seed_from_u64(s ^ (index as u64).wrapping_mul(0x9e37_79b9)),
+                held: Vec::new(),
             }),
             iteration: 0,
             sent_ops: 0,
@@ -789,7 +794,7 @@ impl<M: Model> Worker<M> {
                     self.apply(op);
                 }
             }
-            Some((rng, held)) => {
+            Some(Chaos { rng, held }) => {
                 for op in buf.drain(..) {
                     let delay = rng.gen_range(0..4u64);
                     held.push((self.iteration + delay, op));
@@ -825,8 +830,8 @@ impl<M: Model> Worker<M> {
     /// The smallest time this worker still holds: unhandled messages and held ops.
     fn local_min(&mut self) -> f64 {
         let mut m = self.next_time().unwrap_or(f64::INFINITY);
-        if let Some((_, held)) = &self.chaos {
-            for (_, op) in held {
+        if let Some(c) = &self.chaos {
+            for (_, op) in &c.held {
                 m = m.min(op.time().t());
             }
         }
@@ -917,7 +922,7 @@ impl<M: Model> Worker<M> {
             let window = cfg.window.map_or(f64::INFINITY, |w| self.gvt + w);
             let mut limit = until.min(window);
             let burst = match &mut self.chaos {
-                Some((rng, _)) => rng.gen_range(1..64u32),
+                Some(c) => c.rng.gen_range(1..64u32),
                 None => 64,
             };
             let mut ran = 0;

@@ -107,6 +107,9 @@ where
     }
 }
 
+/// A model's chunk of committed batches.
+type ChunkOf<M> = Chunk<<M as Model>::State, <M as Model>::Output>;
+
 /// Why a Time Warp run stopped early.
 #[derive(Debug)]
 pub enum TwError<E> {
@@ -119,7 +122,7 @@ pub enum TwError<E> {
 /// Committed batches of one round from every worker, merged and fed to the sink.
 pub struct Collector<M: Model> {
     states: Vec<M::State>,
-    rounds: BTreeMap<u64, Vec<Chunk<M::State, M::Output>>>,
+    rounds: BTreeMap<u64, Vec<ChunkOf<M>>>,
     next_round: u64,
     now: Option<VTime>,
     /// Statistics of the workers' last chunks.
