@@ -108,6 +108,12 @@ pub trait Model {
     fn kind(&self, msg: &Self::Msg) -> usize;
     /// Priority inside a batch: lower runs first.
     fn priority(&self, msg: &Self::Msg) -> u8;
+    /// Whether output sinks read object `obj`'s state while the run goes on (an executor that
+    /// keeps states apart, as Time Warp does, ships only these to its collector).
+    fn observed(&self, obj: u32) -> bool {
+        let _ = obj;
+        true
+    }
     /// Sets object `me` up at the start time; it may send messages.
     fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, state: &mut Self::State);
     /// Runs object `me` over one batch of messages, all with the virtual time `ctx.now()`.

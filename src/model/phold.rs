@@ -124,6 +124,10 @@ impl Model for Phold {
         0
     }
 
+    fn observed(&self, _: u32) -> bool {
+        false
+    }
+
     fn init(&self, ctx: &mut Ctx<'_, Phold>, me: u32, state: &mut PholdState) {
         for _ in 0..self.cfg.events_per_object {
             self.send(ctx, me, state);

@@ -593,6 +593,10 @@ impl Model for Pool {
 
     /// Thesis 4.1: each ball tells the higher-numbered balls and every fixed object its initial
     /// trajectory, so every pair is scheduled once.
+    fn observed(&self, obj: u32) -> bool {
+        obj < self.table.n_balls
+    }
+
     fn init(&self, ctx: &mut Ctx<'_, Pool>, me: u32, state: &mut PoolState) {
         match state {
             PoolState::Ball { info, .. } => {

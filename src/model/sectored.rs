@@ -875,6 +875,10 @@ impl Model for Sectored {
 
     /// Thesis 5.4: each ball sends VelocityInitialization to its sectors, which tell only the
     /// balls after it; fixed objects hear from every ball directly.
+    fn observed(&self, obj: u32) -> bool {
+        obj < self.table.n_balls
+    }
+
     fn init(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, state: &mut SecState) {
         if let SecState::Ball { info, sectors, .. } = state {
             for &s in sectors.iter() {

@@ -207,8 +207,8 @@ pub struct Committed<S, O> {
     pub time: VTime,
     /// The object that ran it.
     pub obj: u32,
-    /// The object's state after it.
-    pub state: S,
+    /// The object's state after it, if the model's sinks observe the object.
+    pub state: Option<S>,
     /// What it reported.
     pub output: Vec<O>,
 }
@@ -242,6 +242,8 @@ pub trait Fabric<M: Model>: Sync {
 
 /// A message received and not yet committed.
 struct Entry<Msg> {
+    /// Its simulation time.
+    t: f64,
     /// Positives minus anti-messages: 1 when the message is here and not annulled.
     pos: i8,
     /// Model cancellations minus their undoing.
@@ -342,6 +344,8 @@ struct Lp<M: Model> {
     history: VecDeque<Done<M>>,
     /// Messages it sent that may still be cancelled, by send sequence.
     sends: FxHashMap<u64, Sent>,
+    /// Size of `sends` past which fossil collection sweeps it (amortized: doubled each sweep).
+    sweep_at: usize,
 }
 
 impl<M: Model> Lp<M> {
@@ -427,6 +431,8 @@ pub struct Worker<M: Model> {
     samples: Vec<u64>,
     /// A failure found while committing; the run stops at the next GVT round.
     fault: Option<String>,
+    /// Size of `entries` past which fossil collection sweeps out cancelled messages before GVT.
+    sweep_at: usize,
 }
 
 /// Why a worker stopped early.
@@ -458,6 +464,7 @@ impl<M: Model> Worker<M> {
                     uids: 0,
                     history: VecDeque::new(),
                     sends: FxHashMap::default(),
+                    sweep_at: 64,
                 })
                 .collect(),
             placement,
@@ -483,6 +490,7 @@ impl<M: Model> Worker<M> {
             committed_stats: MessageStats::default(),
             samples: Vec::new(),
             fault: None,
+            sweep_at: 1024,
         }
     }
 
@@ -585,6 +593,7 @@ impl<M: Model> Worker<M> {
             Op::Anti { uid, time, .. } | Op::Cancel { uid, time, .. } => (*uid, time.clone()),
         };
         let e = self.entries.entry(uid).or_insert(Entry {
+            t: time.t(),
             pos: 0,
             cancels: 0,
             p: None,
@@ -862,9 +871,10 @@ impl<M: Model> Worker<M> {
 
     /// Commits every batch before `gvt`: frees its saved state and messages, and returns it
     /// for the collector in (time, object) order.
-    fn fossil_collect(&mut self, gvt: f64) -> Vec<Committed<M::State, M::Output>> {
+    fn fossil_collect(&mut self, model: &M, gvt: f64) -> Vec<Committed<M::State, M::Output>> {
         let mut out = Vec::new();
         for lp in &mut self.lps {
+            let observed = model.observed(lp.id);
             while lp.history.front().is_some_and(|d| d.time.t() < gvt) {
                 let d = lp.history.pop_front().expect("a batch to commit");
                 if let Some(what) = d.into_past {
@@ -873,10 +883,10 @@ impl<M: Model> Worker<M> {
                 }
                 self.uncommitted -= 1;
                 self.stats.committed += 1;
-                let state = match lp.history.front() {
+                let state = observed.then(|| match lp.history.front() {
                     Some(next) => next.pre_state.clone(),
                     None => lp.state.clone(),
-                };
+                });
                 let cs = &mut self.committed_stats;
                 cs.batches += 1;
                 cs.delivered += d.inputs.len() as u64;
@@ -894,9 +904,15 @@ impl<M: Model> Worker<M> {
                     output: d.output,
                 });
             }
-            if !lp.sends.is_empty() {
+            if lp.sends.len() > lp.sweep_at {
                 lp.sends.retain(|_, s| s.time.t() >= gvt);
+                lp.sweep_at = 2 * lp.sends.len().max(32);
             }
+        }
+        if self.entries.len() > self.sweep_at {
+            // cancelled messages before GVT can never come back to life
+            self.entries.retain(|_, e| e.t >= gvt);
+            self.sweep_at = 2 * self.entries.len().max(512);
         }
         out.sort_by(|a, b| a.time.cmp(&b.time).then(a.obj.cmp(&b.obj)));
         self.samples
@@ -970,7 +986,7 @@ impl<M: Model> Worker<M> {
                 Err(s) => break Err(s),
                 Ok(gvt) => {
                     self.gvt = gvt;
-                    let batches = self.fossil_collect(gvt);
+                    let batches = self.fossil_collect(model, gvt);
                     self.round += 1;
                     fabric.commit(Chunk {
                         worker: self.index,

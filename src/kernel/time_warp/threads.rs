@@ -181,7 +181,9 @@ impl<M: Model> Collector<M> {
                 chunks.into_iter().flat_map(|c| c.batches).collect();
             batches.sort_by(|a, b| a.time.cmp(&b.time).then(a.obj.cmp(&b.obj)));
             for c in batches {
-                self.states[c.obj as usize] = c.state;
+                if let Some(state) = c.state {
+                    self.states[c.obj as usize] = state;
+                }
                 for o in c.output {
                     if let Err(e) = sink(model, &self.states, o) {
                         *failed = Some(TwError::Sink(e));
@@ -321,6 +323,14 @@ where
                 }
             }
         });
+        if failed.is_none() {
+            // every batch is committed: the workers' states are final, unobserved ones included
+            for w in workers.iter() {
+                for (id, state) in w.states() {
+                    collector.states[id as usize] = state.clone();
+                }
+            }
+        }
         match failed {
             Some(e) => Err(e),
             None => Ok(()),
