@@ -111,7 +111,7 @@ impl Mul<Vec2> for f64 {
 ///
 /// The thesis writes it `s(t) = D + t·v` with `D = s(t0) - t0·v` (3.1); we keep the position fix
 /// itself, which loses no precision when `t0` is large.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Trajectory {
     /// Position at `t0` (length).
     pub position: Vec2,

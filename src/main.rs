@@ -544,6 +544,25 @@ fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
     }
 }
 
+/// MPI, when this process was started by `mpirun` (cargo feature `mpi`), held for the run.
+#[cfg(feature = "mpi")]
+fn start_mpi() -> Result<Option<mpi::environment::Universe>, Failure> {
+    let launched = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some());
+    if !launched {
+        return Ok(None);
+    }
+    use mpi::Threading;
+    match mpi::initialize_with_threading(Threading::Serialized) {
+        Some((u, Threading::Serialized | Threading::Multiple)) => Ok(Some(u)),
+        Some(_) => Err(internal(
+            "MPI: the library cannot serve calls from several threads (MPI_THREAD_SERIALIZED)",
+        )),
+        None => Err(internal("MPI: initialization failed")),
+    }
+}
+
 /// Time Warp's settings from the flags and `POOLSIM_CHAOS`.
 fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
     let mut tw = TwConfig {
@@ -625,7 +644,11 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         check: a.check,
         span: Default::default(),
     };
-    let mut trace = match &a.trace {
+    #[cfg(feature = "mpi")]
+    let _mpi = if time_warp { start_mpi()? } else { None };
+    // under MPI only rank 0 writes anything
+    let root = poolsim::kernel::time_warp::threads::place().0 == 0;
+    let mut trace = match a.trace.as_ref().filter(|_| root) {
         Some(p) => Some(TraceWriter::new(BufWriter::new(File::create(p).map_err(
             |e| {
                 usage(format!(
@@ -636,7 +659,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         )?))),
         None => None,
     };
-    let mut progress = Progress::new(until, a.quiet);
+    let mut progress = Progress::new(until, a.quiet || !root);
     let report = {
         let mut sinks = Sinks {
             trace: trace.as_mut(),
@@ -655,6 +678,9 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         RunError::Input(m) => usage(m),
         e => internal(e.to_string()),
     })?;
+    if !root {
+        return Ok(());
+    }
     if let Some(p) = &a.final_state {
         let fs = FinalState::new(report.outcome.t, &report.outcome.balls);
         let text = serde_json::to_string_pretty(&fs).expect("a final state serializes");

@@ -18,7 +18,9 @@ use crate::scenario::Scenario;
 use std::fmt;
 
 /// What kind of physical event happened; the names are the trace's `kind` strings.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 pub enum EventKind {
     /// Two balls collided.
     BallBall,
@@ -52,7 +54,7 @@ impl EventKind {
 
 /// One executed physical event. Objects are global indices (see [`Table`]); `a < b` always, and
 /// `a` is a ball.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Event {
     /// Simulation time of the event.
     pub t: f64,
@@ -65,7 +67,7 @@ pub struct Event {
 }
 
 /// A fixed object of the table, by its index within its own kind (0-based).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Fixed {
     /// Cushion `k` (`Cushion-{k+1}`).
     Cushion(u32),
@@ -222,7 +224,7 @@ impl Table {
 
 /// The state of one ball: its trajectory since its last velocity change, size and mass, and the
 /// pocket it dropped into, if any (then `traj` holds where and how it crossed the pocket line).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BallState {
     /// Trajectory since the last velocity change.
     pub traj: Trajectory,

@@ -6,7 +6,7 @@ use super::{
     partition, BallState, EventCounts, Frame, Observer, Outcome, RunError, Span, Table, World,
 };
 use crate::kernel::sequential::{Sequential, Sink};
-use crate::kernel::time_warp::threads::{TimeWarp, TwError};
+use crate::kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
 use crate::kernel::time_warp::{TwConfig, TwStats};
 use crate::kernel::{MessageStats, Model, VTime};
 use crate::model::pool::{BallInfo, NvDelay, Pool, PoolOutput, PoolState};
@@ -167,7 +167,7 @@ impl Objects {
     pub fn plain_on(s: &Scenario, delay: NvDelay, span: Span, tw: Option<TwConfig>) -> Objects {
         let (model, states) = Pool::new(s, delay, span);
         let tw = tw.map(|c| {
-            let mut w = partition::plain(s, c.workers);
+            let mut w = partition::plain(s, total_workers(&c));
             w.resize(states.len(), 0);
             (c, w)
         });
@@ -183,7 +183,7 @@ impl Objects {
     /// the balls that start in it on one worker.
     pub fn sectored_on(s: &Scenario, layout: Layout, span: Span, tw: Option<TwConfig>) -> Objects {
         let tw = tw.map(|c| {
-            let w = partition::sectored(s, &layout, c.workers);
+            let w = partition::sectored(s, &layout, total_workers(&c));
             (c, w)
         });
         let (model, states) = Sectored::new(s, layout, span);

@@ -25,6 +25,8 @@ pub mod sequential;
 pub mod time_warp;
 
 use crate::vtime::Key;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
 use std::cmp::Ordering;
 use std::fmt::Debug;
 
@@ -74,7 +76,9 @@ impl Ord for VTime {
 }
 
 /// Names a sent message so that its sender can cancel it: the sender and its send sequence.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 pub struct Handle {
     /// The sending object.
     pub from: u32,
@@ -95,12 +99,12 @@ pub struct Envelope<M> {
 
 /// A simulation model for the kernel: message and state types and the objects' behaviour.
 pub trait Model {
-    /// Message payloads.
-    type Msg: Clone + Debug;
+    /// Message payloads (serializable, so that Time Warp can carry them between ranks).
+    type Msg: Clone + Debug + Serialize + DeserializeOwned;
     /// One object's state.
-    type State: Clone;
+    type State: Clone + Serialize + DeserializeOwned;
     /// What objects report as they go (physical events, drawings): committed output.
-    type Output;
+    type Output: Serialize + DeserializeOwned;
 
     /// Names of the message types, indexed by [`Model::kind`], for the statistics.
     fn kind_names(&self) -> &'static [&'static str];

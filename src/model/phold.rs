@@ -36,7 +36,7 @@ pub struct PholdConfig {
 }
 
 /// One PHOLD object: its random stream and its counts.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct PholdState {
     rng: ChaCha8Rng,
     sends: u64,

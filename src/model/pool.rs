@@ -41,7 +41,7 @@ use crate::vtime::{pair, Key, DISPLAY, REVERSAL};
 use std::sync::Arc;
 
 /// What a ball tells others about itself.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BallInfo {
     /// Trajectory since its last velocity change.
     pub traj: Trajectory,
@@ -93,7 +93,7 @@ impl BallInfo {
 }
 
 /// Messages of the pool simulation.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum PoolMsg {
     /// A ball's new trajectory (thesis NewVelocity).
     NewVelocity(Arc<BallInfo>),
@@ -114,7 +114,7 @@ pub enum PoolMsg {
 }
 
 /// What the pool objects report.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum PoolOutput {
     /// A physical event.
     Event(Event),
@@ -141,7 +141,7 @@ pub const RETURN_TO_TABLE: usize = 3;
 pub const DISPLAY_YOURSELF: usize = 4;
 
 /// One collision an object scheduled: the partner and the two Collision messages.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Planned {
     /// The other object of the collision (the one that is not the scheduler).
     pub partner: u32,
@@ -171,7 +171,7 @@ pub fn cancel_with<M: Model + ?Sized>(
 }
 
 /// A pool object's state.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum PoolState {
     /// A ball and the collisions it scheduled.
     Ball {

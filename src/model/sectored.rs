@@ -158,7 +158,7 @@ impl Layout {
 }
 
 /// Messages of the sectored simulation.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum SecMsg {
     /// A ball's trajectory, relayed by a sector or sent to a fixed object.
     NewVelocity {
@@ -230,7 +230,7 @@ const KIND_NAMES: [&str; 9] = [
 ];
 
 /// A sector's scheduled entry or departure of one ball.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Passage {
     /// The ball.
     pub ball: u32,
@@ -245,7 +245,7 @@ pub struct Passage {
 }
 
 /// An object's state in the sectored simulation.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum SecState {
     /// A ball.
     Ball {

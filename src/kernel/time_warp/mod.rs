@@ -33,6 +33,8 @@
 //! are freed (fossil collection). The transport and the reductions are a [`Fabric`]: threads
 //! ([`threads`]) or MPI ranks.
 
+#[cfg(feature = "mpi")]
+pub mod mpi;
 pub mod threads;
 
 use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime};
@@ -224,6 +226,8 @@ pub struct Chunk<S, O> {
     pub batches: Vec<Committed<S, O>>,
     /// Set on the worker's last chunk of a run: its statistics.
     pub last: Option<(TwStats, MessageStats, u64)>,
+    /// On the last chunk of a run that ended well: the worker's objects' final states.
+    pub finals: Vec<(u32, S)>,
     /// Set when the worker stopped on an error.
     pub error: Option<String>,
 }
@@ -521,12 +525,12 @@ impl<M: Model> Worker<M> {
         self.drain_local();
     }
 
-    /// Takes the ops waiting for other workers: `(worker, ops)`.
-    pub fn take_outbox(&mut self) -> Vec<(usize, Vec<Op<M::Msg>>)> {
+    /// Takes the ops waiting for workers `to` (uncounted: the caller delivers them itself,
+    /// or a fabric counts them).
+    pub fn take_outbox(&mut self, to: std::ops::Range<usize>) -> Vec<(usize, Vec<Op<M::Msg>>)> {
         let mut out = Vec::new();
         for (w, ops) in self.outbox.iter_mut().enumerate() {
-            if !ops.is_empty() {
-                self.sent_ops += ops.len() as i64;
+            if to.contains(&w) && !ops.is_empty() {
                 out.push((w, std::mem::take(ops)));
             }
         }
@@ -535,7 +539,6 @@ impl<M: Model> Worker<M> {
 
     /// Accepts ops handed over outside a fabric (at set-up).
     pub fn accept(&mut self, ops: Vec<Op<M::Msg>>) {
-        self.received_ops += ops.len() as i64;
         for op in ops {
             self.apply(op);
         }
@@ -831,7 +834,8 @@ impl<M: Model> Worker<M> {
     }
 
     fn flush<F: Fabric<M>>(&mut self, fabric: &F) {
-        for (w, ops) in self.take_outbox() {
+        for (w, ops) in self.take_outbox(0..self.outbox.len()) {
+            self.sent_ops += ops.len() as i64;
             fabric.send(self.index, w, ops);
         }
     }
@@ -993,6 +997,7 @@ impl<M: Model> Worker<M> {
                         round: self.round,
                         batches,
                         last: None,
+                        finals: Vec::new(),
                         error: None,
                     });
                     if gvt > until {
@@ -1014,6 +1019,14 @@ impl<M: Model> Worker<M> {
                 std::mem::take(&mut self.committed_stats),
                 self.pending_len() as u64,
             )),
+            finals: if result.is_ok() {
+                self.lps
+                    .iter()
+                    .map(|lp| (lp.id, lp.state.clone()))
+                    .collect()
+            } else {
+                Vec::new()
+            },
             error,
         });
         result

@@ -161,6 +161,9 @@ impl<M: Model> Collector<M> {
             self.stats.add(stats);
             self.messages.add(messages);
             self.pending += pending;
+            for (id, state) in chunk.finals {
+                self.states[id as usize] = state;
+            }
             if let (Some(e), None) = (&chunk.error, &failed) {
                 *failed = Some(TwError::Failed(e.clone()));
             }
@@ -204,12 +207,32 @@ impl<M: Model> Collector<M> {
     }
 }
 
-/// The Time Warp executor on threads: the same interface as the sequential one.
+/// The Time Warp executor: worker threads, and across MPI ranks where MPI is running (cargo
+/// feature `mpi`); the same interface as the sequential executor.
 pub struct TimeWarp<M: Model> {
     model: M,
     workers: Vec<Worker<M>>,
     cfg: TwConfig,
     collector: Collector<M>,
+    rank: usize,
+    ranks: usize,
+}
+
+/// This process's MPI rank and the number of ranks; `(0, 1)` without MPI.
+pub fn place() -> (usize, usize) {
+    #[cfg(feature = "mpi")]
+    {
+        super::mpi::place()
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        (0, 1)
+    }
+}
+
+/// Workers in all (every rank's) for `cfg`.
+pub fn total_workers(cfg: &TwConfig) -> usize {
+    cfg.workers.max(1) * place().1
 }
 
 impl<M> TimeWarp<M>
@@ -219,8 +242,8 @@ where
     M::State: Send,
     M::Output: Send,
 {
-    /// Places the objects on `cfg.workers` workers (`worker_of[o]` for object `o`) and runs
-    /// every object's `init` at `start`.
+    /// Places the objects on the workers of every rank (`worker_of[o]` for object `o`, below
+    /// [`total_workers`]) and runs the `init` of this rank's objects at `start`.
     pub fn new(
         model: M,
         states: Vec<M::State>,
@@ -229,22 +252,28 @@ where
         cfg: TwConfig,
     ) -> TimeWarp<M> {
         assert_eq!(worker_of.len(), states.len(), "one worker per object");
-        let n = cfg.workers.max(1);
-        let placement = Arc::new(Placement::new(worker_of, n));
-        let mut per: Vec<Vec<(u32, M::State)>> = (0..n).map(|_| Vec::new()).collect();
+        let (rank, ranks) = place();
+        let per = cfg.workers.max(1);
+        let placement = Arc::new(Placement::new(worker_of, per * ranks));
+        let mine = rank * per..(rank + 1) * per;
+        let mut local: Vec<Vec<(u32, M::State)>> = (0..per).map(|_| Vec::new()).collect();
         for (o, s) in states.iter().enumerate() {
-            per[placement.worker(o as u32)].push((o as u32, s.clone()));
+            let w = placement.worker(o as u32);
+            if mine.contains(&w) {
+                local[w - mine.start].push((o as u32, s.clone()));
+            }
         }
-        let mut workers: Vec<Worker<M>> = per
+        let mut workers: Vec<Worker<M>> = local
             .into_iter()
             .enumerate()
-            .map(|(w, st)| Worker::new(w, placement.clone(), st, cfg.chaos))
+            .map(|(k, st)| Worker::new(mine.start + k, placement.clone(), st, cfg.chaos))
             .collect();
-        let mut mail: Vec<Vec<Op<M::Msg>>> = (0..n).map(|_| Vec::new()).collect();
+        // init's sends to this rank's workers are delivered here; others wait in outboxes
+        let mut mail: Vec<Vec<Op<M::Msg>>> = (0..per).map(|_| Vec::new()).collect();
         for w in &mut workers {
             w.init(&model, &start);
-            for (to, ops) in w.take_outbox() {
-                mail[to].extend(ops);
+            for (to, ops) in w.take_outbox(mine.clone()) {
+                mail[to - mine.start].extend(ops);
             }
         }
         for (w, ops) in workers.iter_mut().zip(mail) {
@@ -255,6 +284,8 @@ where
             workers,
             cfg,
             collector: Collector::new(states),
+            rank,
+            ranks,
         }
     }
 
@@ -263,26 +294,31 @@ where
         &self.model
     }
 
-    /// Every object's committed state.
+    /// Every object's committed state (on rank 0 under MPI).
     pub fn states(&self) -> &[M::State] {
         self.collector.states()
     }
 
-    /// Committed message statistics.
+    /// Committed message statistics (on rank 0 under MPI).
     pub fn stats(&self) -> &MessageStats {
         &self.collector.messages
     }
 
-    /// Time Warp's own statistics.
+    /// Time Warp's own statistics (every rank's, on rank 0 under MPI).
     pub fn tw_stats(&self) -> TwStats {
         let mut s = self.collector.stats.clone();
-        s.ranks = 1;
+        s.ranks = self.ranks as u64;
         s
     }
 
-    /// Live messages waiting.
+    /// Live messages waiting (every rank's, on rank 0 under MPI).
     pub fn pending_len(&self) -> usize {
-        self.workers.iter().map(|w| w.pending_len()).sum()
+        self.collector.pending as usize
+    }
+
+    /// This process's MPI rank (0 without MPI): only rank 0 feeds the sink.
+    pub fn rank(&self) -> usize {
+        self.rank
     }
 
     /// Every worker's memory samples (uncommitted batches plus held messages) per GVT round.
@@ -291,49 +327,86 @@ where
     }
 
     /// Runs every batch with time at most `until` optimistically on the workers; the sink sees
-    /// each output, with the committed states just after its batch, in the sequential order.
+    /// each output, with the committed states just after its batch, in the sequential order
+    /// (on rank 0 only, under MPI).
     pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), TwError<E>> {
-        let n = self.workers.len();
         let (tx, rx) = mpsc::channel();
-        let fabric = ThreadFabric::<M>::new(n, tx);
-        let stop = AtomicBool::new(false);
-        let TimeWarp {
-            model,
-            workers,
-            cfg,
-            collector,
-        } = self;
-        let model: &M = model;
         let mut failed: Option<TwError<E>> = None;
-        std::thread::scope(|scope| {
-            for w in workers.iter_mut() {
-                let (fabric, stop, cfg) = (&fabric, &stop, &*cfg);
-                scope.spawn(move || w.run(model, fabric, cfg, until, stop));
-            }
-            let mut finished = 0;
-            collector.stats = TwStats::default();
-            while finished < n {
-                let chunk = rx.recv().expect("workers send a last chunk");
-                if chunk.last.is_some() {
-                    finished += 1;
-                }
-                collector.take(model, n, chunk, sink, &mut failed);
-                if failed.is_some() {
-                    stop.store(true, Ordering::Relaxed);
-                }
-            }
-        });
-        if failed.is_none() {
-            // every batch is committed: the workers' states are final, unobserved ones included
-            for w in workers.iter() {
-                for (id, state) in w.states() {
-                    collector.states[id as usize] = state.clone();
+        self.collector.stats = TwStats::default();
+        self.collector.pending = 0;
+        if self.ranks == 1 {
+            let fabric = ThreadFabric::<M>::new(self.workers.len(), tx);
+            self.drive(&fabric, &rx, until, sink, &mut failed);
+        } else {
+            #[cfg(feature = "mpi")]
+            {
+                let fabric = super::mpi::MpiFabric::<M>::new(
+                    self.rank,
+                    self.ranks,
+                    self.workers.len(),
+                    (self.rank == 0).then_some(tx),
+                );
+                self.drive(&fabric, &rx, until, sink, &mut failed);
+                // the last chunks of other ranks are still in parcels: one more exchange
+                fabric.exchange();
+                fabric.close_collector();
+                let total = self.workers.len() * self.ranks;
+                for chunk in rx.try_iter() {
+                    self.collector
+                        .take(&self.model, total, chunk, sink, &mut failed);
                 }
             }
         }
         match failed {
             Some(e) => Err(e),
             None => Ok(()),
+        }
+    }
+
+    /// Runs the workers on `fabric` until they stop, collecting what reaches `rx` meanwhile.
+    fn drive<F: Fabric<M>, E>(
+        &mut self,
+        fabric: &F,
+        rx: &mpsc::Receiver<ChunkOf<M>>,
+        until: f64,
+        sink: &mut Sink<'_, M, E>,
+        failed: &mut Option<TwError<E>>,
+    ) {
+        let total = self.workers.len() * self.ranks;
+        let stop = AtomicBool::new(false);
+        let TimeWarp {
+            model,
+            workers,
+            cfg,
+            collector,
+            ..
+        } = self;
+        let model: &M = model;
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = workers
+                .iter_mut()
+                .map(|w| {
+                    let (stop, cfg) = (&stop, &*cfg);
+                    scope.spawn(move || w.run(model, fabric, cfg, until, stop))
+                })
+                .collect();
+            loop {
+                match rx.recv_timeout(std::time::Duration::from_millis(1)) {
+                    Ok(chunk) => collector.take(model, total, chunk, sink, failed),
+                    Err(mpsc::RecvTimeoutError::Timeout) => {
+                        if handles.iter().all(|h| h.is_finished()) {
+                            break;
+                        }
+                    }
+                    Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                }
+                if failed.is_some() {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
+        });
+        for chunk in rx.try_iter() {
+            collector.take(model, total, chunk, sink, failed);
         }
     }
 }

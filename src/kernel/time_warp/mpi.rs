@@ -1,0 +1,205 @@
+//! Time Warp across MPI ranks (cargo feature `mpi`): each rank runs its workers as threads,
+//! and ranks exchange ops and committed chunks in bulk at every reduction of a GVT round.
+//!
+//! ```text
+//!   rank 0: workers 0..N ─┐ intra-rank reduce ─► worker 0 of the rank: all-to-all of parcels,
+//!   rank 1: workers N..2N ┘                      then all-reduce of the GVT values (MPI)
+//! ```
+//!
+//! Within a rank, ops go through shared inboxes at once; ops for another rank wait in a
+//! parcel until the next reduction, where an `MPI_Alltoallv` delivers every parcel. The
+//! reduction's op counting (ROSS's approach) sees ops in parcels as in flight, so GVT is exact
+//! whatever the delay. Committed chunks of other ranks travel the same way to rank 0, whose
+//! collector feeds the sink. Only the first thread of a rank calls MPI, and never two at once
+//! (MPI is initialized with `Threading::Serialized`); no other network layer is involved.
+
+use super::threads::ThreadReduce;
+use super::{Chunk, Fabric, Op, Reduction};
+use crate::kernel::Model;
+use mpi::collective::SystemOperation;
+use mpi::datatype::{Partition, PartitionMut};
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::sync::{mpsc, Barrier, Mutex};
+
+/// This process's place among the MPI ranks: `(rank, ranks)`, or `(0, 1)` when MPI is not
+/// initialized.
+pub fn place() -> (usize, usize) {
+    if !mpi::environment::is_initialized() || mpi::environment::is_finalized() {
+        return (0, 1);
+    }
+    let world = SimpleCommunicator::world();
+    (world.rank() as usize, world.size() as usize)
+}
+
+/// What travels between ranks.
+#[derive(serde::Serialize, serde::Deserialize)]
+enum Parcel<Msg, S, O> {
+    /// Ops for global worker `.0`.
+    Ops(usize, Vec<Op<Msg>>),
+    /// A committed chunk for rank 0's collector.
+    Chunk(Chunk<S, O>),
+}
+
+type ParcelOf<M> = Parcel<<M as Model>::Msg, <M as Model>::State, <M as Model>::Output>;
+
+/// The workers of this rank, and the way to the others.
+pub struct MpiFabric<M: Model> {
+    rank: usize,
+    ranks: usize,
+    per_rank: usize,
+    inboxes: Vec<Mutex<Vec<Op<M::Msg>>>>,
+    outgoing: Mutex<Vec<Vec<ParcelOf<M>>>>,
+    reduce: ThreadReduce,
+    barrier: Barrier,
+    result: Mutex<Reduction>,
+    collector: Mutex<Option<mpsc::Sender<Chunk<M::State, M::Output>>>>,
+}
+
+impl<M: Model> MpiFabric<M>
+where
+    M::Msg: Serialize + DeserializeOwned,
+    M::State: Serialize + DeserializeOwned,
+    M::Output: Serialize + DeserializeOwned,
+{
+    /// The fabric of rank `rank` of `ranks`, with `per_rank` workers each; rank 0 passes the
+    /// collector's channel.
+    pub fn new(
+        rank: usize,
+        ranks: usize,
+        per_rank: usize,
+        collector: Option<mpsc::Sender<Chunk<M::State, M::Output>>>,
+    ) -> Self {
+        MpiFabric {
+            rank,
+            ranks,
+            per_rank,
+            inboxes: (0..per_rank).map(|_| Mutex::new(Vec::new())).collect(),
+            outgoing: Mutex::new((0..ranks).map(|_| Vec::new()).collect()),
+            reduce: ThreadReduce::new(per_rank),
+            barrier: Barrier::new(per_rank),
+            result: Mutex::new(super::threads::NOTHING),
+            collector: Mutex::new(collector),
+        }
+    }
+
+    fn local(&self, worker: usize) -> Option<usize> {
+        (worker / self.per_rank == self.rank).then_some(worker % self.per_rank)
+    }
+
+    fn deliver(&self, parcel: ParcelOf<M>) {
+        match parcel {
+            Parcel::Ops(w, mut ops) => {
+                let k = self.local(w).expect("parcels reach their rank");
+                self.inboxes[k]
+                    .lock()
+                    .expect("no thread panicked")
+                    .append(&mut ops);
+            }
+            Parcel::Chunk(c) => {
+                if let Some(tx) = &*self.collector.lock().expect("no thread panicked") {
+                    let _ = tx.send(c);
+                }
+            }
+        }
+    }
+
+    /// Delivers every waiting parcel to its rank: one all-to-all of counts, one of bytes. Every
+    /// rank must call it the same number of times, from one thread at a time.
+    pub fn exchange(&self) {
+        let world = SimpleCommunicator::world();
+        let parcels = std::mem::replace(
+            &mut *self.outgoing.lock().expect("no thread panicked"),
+            (0..self.ranks).map(|_| Vec::new()).collect(),
+        );
+        // never an empty buffer: two empty vectors share a dangling address, which MPI would
+        // take for an in-place exchange
+        let mut send: Vec<u8> = Vec::with_capacity(64);
+        let mut counts = vec![0i32; self.ranks];
+        let mut displs = vec![0i32; self.ranks];
+        for (r, ps) in parcels.iter().enumerate() {
+            displs[r] = send.len() as i32;
+            if !ps.is_empty() {
+                bincode::serialize_into(&mut send, ps).expect("parcels serialize");
+            }
+            counts[r] = send.len() as i32 - displs[r];
+        }
+        let mut rcounts = vec![0i32; self.ranks];
+        world.all_to_all_into(&counts[..], &mut rcounts[..]);
+        let mut rdispls = vec![0i32; self.ranks];
+        let mut total = 0i32;
+        for r in 0..self.ranks {
+            rdispls[r] = total;
+            total += rcounts[r];
+        }
+        let mut recv = vec![0u8; (total as usize).max(1)];
+        world.all_to_all_varcount_into(
+            &Partition::new(&send[..], &counts[..], &displs[..]),
+            &mut PartitionMut::new(&mut recv[..], &rcounts[..], &rdispls[..]),
+        );
+        for r in 0..self.ranks {
+            if rcounts[r] == 0 {
+                continue;
+            }
+            let bytes = &recv[rdispls[r] as usize..(rdispls[r] + rcounts[r]) as usize];
+            let ps: Vec<ParcelOf<M>> = bincode::deserialize(bytes).expect("parcels deserialize");
+            for p in ps {
+                self.deliver(p);
+            }
+        }
+    }
+
+    /// Stops handing chunks to the collector (its channel closes when the last sender goes).
+    pub fn close_collector(&self) {
+        self.collector.lock().expect("no thread panicked").take();
+    }
+}
+
+impl<M: Model> Fabric<M> for MpiFabric<M>
+where
+    M::Msg: Serialize + DeserializeOwned + Send,
+    M::State: Serialize + DeserializeOwned + Send,
+    M::Output: Serialize + DeserializeOwned + Send,
+{
+    fn send(&self, _from: usize, to: usize, mut ops: Vec<Op<M::Msg>>) {
+        match self.local(to) {
+            Some(k) => self.inboxes[k]
+                .lock()
+                .expect("no thread panicked")
+                .append(&mut ops),
+            None => self.outgoing.lock().expect("no thread panicked")[to / self.per_rank]
+                .push(Parcel::Ops(to, ops)),
+        }
+    }
+
+    fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
+        let k = self.local(me).expect("a worker of this rank");
+        into.append(&mut self.inboxes[k].lock().expect("no thread panicked"));
+    }
+
+    fn reduce(&self, me: usize, local: Reduction) -> Reduction {
+        let k = self.local(me).expect("a worker of this rank");
+        let here = self.reduce.reduce(k, local);
+        if k == 0 {
+            self.exchange();
+            let world = SimpleCommunicator::world();
+            let mut g = here;
+            world.all_reduce_into(&here.in_flight, &mut g.in_flight, SystemOperation::sum());
+            world.all_reduce_into(&here.min_t, &mut g.min_t, SystemOperation::min());
+            world.all_reduce_into(&here.stop, &mut g.stop, SystemOperation::sum());
+            *self.result.lock().expect("no thread panicked") = g;
+        }
+        self.barrier.wait();
+        *self.result.lock().expect("no thread panicked")
+    }
+
+    fn commit(&self, chunk: Chunk<M::State, M::Output>) {
+        if self.rank == 0 {
+            self.deliver(Parcel::Chunk(chunk));
+        } else {
+            self.outgoing.lock().expect("no thread panicked")[0].push(Parcel::Chunk(chunk));
+        }
+    }
+}
