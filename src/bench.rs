@@ -228,18 +228,24 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         }
         sectored.push(r);
     }
-    let phold = crate::model::phold::run_sequential(
-        crate::model::phold::PholdConfig {
-            objects: a.phold_objects,
-            events_per_object: 16,
-            remote: 0.1,
-            partitions: 2,
-            lookahead: 0.1,
-            mean: 1.0,
-            seed: 1,
-        },
-        20.0,
-    );
+    // PHOLD: the sequential kernel, then Time Warp on 1 and 2 workers (2 partitions each)
+    let phold_cfg = crate::model::phold::PholdConfig {
+        objects: a.phold_objects,
+        events_per_object: 16,
+        remote: 0.1,
+        partitions: 2,
+        lookahead: 0.1,
+        mean: 1.0,
+        seed: 1,
+    };
+    let mut phold = Vec::new();
+    for workers in [None, Some(1), Some(2)] {
+        let tw = workers.map(|w| crate::kernel::time_warp::TwConfig {
+            workers: w,
+            ..Default::default()
+        });
+        phold.push(crate::model::phold::run(phold_cfg.clone(), 20.0, tw));
+    }
     if a.json {
         println!(
             "{}",
@@ -248,11 +254,20 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         );
     } else {
         println!();
-        println!(
-            "PHOLD, sequential kernel: {} objects x 16 events, remote 0.1, end 20: {} committed, \
-             {:.0} events/s",
-            phold.objects, phold.committed, phold.events_per_second
-        );
+        for p in &phold {
+            let workers = p.time_warp.as_ref().map_or(0, |t| t.workers);
+            println!(
+                "PHOLD {} objects x 16 events, remote 0.1, end 20, {} ({} workers): {} \
+                 committed, {:.0} events/s, efficiency {:.3}, digest {}",
+                p.objects,
+                p.engine,
+                workers,
+                p.committed,
+                p.events_per_second,
+                p.time_warp.as_ref().map_or(1.0, |t| t.efficiency()),
+                p.final_state_digest
+            );
+        }
     }
     Ok(())
 }

@@ -274,9 +274,16 @@ struct PholdArgs {
     /// Probability that a message goes to another partition.
     #[arg(long, default_value_t = 0.1)]
     remote: f64,
-    /// Partitions (workers of a parallel run); objects are split in equal blocks.
-    #[arg(long, default_value_t = 2)]
-    partitions: u32,
+    /// Partitions; objects are split in equal blocks (default: the Time Warp workers of all
+    /// ranks, or 2 on the sequential kernel).
+    #[arg(long)]
+    partitions: Option<u32>,
+    /// objects (the sequential kernel) or time-warp.
+    #[arg(long, default_value = "objects")]
+    engine: String,
+    /// Time Warp workers per rank (default: this machine's cores).
+    #[arg(long)]
+    workers: Option<usize>,
     /// End time.
     #[arg(long, default_value_t = 100.0)]
     end: f64,
@@ -295,7 +302,7 @@ struct PholdArgs {
 }
 
 fn phold(a: &PholdArgs) -> Result<(), Failure> {
-    use poolsim::model::phold::{run_sequential, PholdConfig};
+    use poolsim::model::phold::{run, PholdConfig};
     let positive = |flag: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
             Ok(())
@@ -317,24 +324,61 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
             a.remote
         )));
     }
-    if a.objects == 0 || a.partitions == 0 || a.partitions > a.objects {
+    let tw = match a.engine.as_str() {
+        "objects" => {
+            if a.workers.is_some() {
+                return Err(usage("--workers: only the time-warp engine takes it"));
+            }
+            None
+        }
+        "time-warp" => {
+            let mut tw = TwConfig {
+                workers: std::thread::available_parallelism().map_or(1, |n| n.get()),
+                chaos: time_warp::chaos_from_env().map_err(usage)?,
+                ..TwConfig::default()
+            };
+            if let Some(w) = a.workers {
+                if !(1..=1024).contains(&w) {
+                    return Err(usage(format!("--workers: must be 1 to 1024, got {w}")));
+                }
+                tw.workers = w;
+            }
+            Some(tw)
+        }
+        other => {
+            return Err(usage(format!(
+                "--engine: PHOLD runs on objects or time-warp, not `{other}`"
+            )))
+        }
+    };
+    #[cfg(feature = "mpi")]
+    let _mpi = if tw.is_some() { start_mpi()? } else { None };
+    let partitions = a.partitions.unwrap_or_else(|| match &tw {
+        Some(c) => poolsim::kernel::time_warp::threads::total_workers(c) as u32,
+        None => 2,
+    });
+    if a.objects == 0 || partitions == 0 || partitions > a.objects {
         return Err(usage(format!(
             "--objects and --partitions: need 1 <= partitions <= objects, got {} and {}",
-            a.partitions, a.objects
+            partitions, a.objects
         )));
     }
-    let report = run_sequential(
+    let report = run(
         PholdConfig {
             objects: a.objects,
             events_per_object: a.events_per_object,
             remote: a.remote,
-            partitions: a.partitions,
+            partitions,
             lookahead: a.lookahead,
             mean: a.mean,
             seed: a.seed,
         },
         a.end,
+        tw,
     );
+    if poolsim::kernel::time_warp::threads::place().0 != 0 {
+        return Ok(());
+    }
     if a.json {
         println!(
             "{}",
@@ -342,8 +386,9 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
         );
     } else {
         println!(
-            "PHOLD {} objects x {} events, remote {}, {} partitions, end {}: {} committed events \
-             in {:.3} s, {:.0} events/s",
+            "PHOLD on {}, {} objects x {} events, remote {}, {} partitions, end {}: {} committed \
+             events in {:.3} s, {:.0} events/s, digest {}",
+            report.engine,
             report.objects,
             report.events_per_object,
             report.remote,
@@ -351,8 +396,22 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
             report.end,
             report.committed,
             report.wall_seconds,
-            report.events_per_second
+            report.events_per_second,
+            report.final_state_digest
         );
+        if let Some(t) = &report.time_warp {
+            println!(
+                "time warp: {} workers on {} ranks, processed {}, committed {}, efficiency {:.3}, \
+                 {} rollbacks, {} GVT rounds",
+                t.workers,
+                t.ranks,
+                t.processed,
+                t.committed,
+                t.efficiency(),
+                t.rollbacks,
+                t.gvt_rounds
+            );
+        }
     }
     Ok(())
 }

@@ -113,20 +113,24 @@ impl FinalState {
 /// A 64-bit FNV-1a hash, in hex, of every ball's final position and velocity bits (and pocket):
 /// equal digests mean bit-identical final states.
 pub fn digest(t: f64, balls: &[BallState]) -> String {
+    fnv_hex(balls.iter().flat_map(|b| {
+        let p = b.position(t);
+        let v = b.velocity();
+        [p.x, p.y, v.x, v.y]
+            .map(f64::to_bits)
+            .into_iter()
+            .chain([b.pocket.map_or(u64::MAX, u64::from)])
+    }))
+}
+
+/// A 64-bit FNV-1a hash, in hex, of a sequence of words (little-endian bytes).
+pub fn fnv_hex(words: impl IntoIterator<Item = u64>) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut eat = |x: u64| {
+    for x in words {
         for byte in x.to_le_bytes() {
             h ^= u64::from(byte);
             h = h.wrapping_mul(0x0100_0000_01b3);
         }
-    };
-    for b in balls {
-        let p = b.position(t);
-        let v = b.velocity();
-        for x in [p.x, p.y, v.x, v.y] {
-            eat(x.to_bits());
-        }
-        eat(b.pocket.map_or(u64::MAX, u64::from));
     }
     format!("{h:016x}")
 }

@@ -11,7 +11,12 @@
 //! draws from its own seeded random stream, kept in its state, so a run is the same whatever
 //! executes it.
 
+use crate::kernel::sequential::Sequential;
+use crate::kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
+use crate::kernel::time_warp::{TwConfig, TwStats};
 use crate::kernel::{Ctx, Envelope, Model, VTime};
+use crate::output::fnv_hex;
+use std::convert::Infallible;
 use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -161,7 +166,7 @@ pub struct PholdReport {
     pub partitions: u32,
     /// End time.
     pub end: f64,
-    /// Executor: `objects` (sequential).
+    /// Executor: `objects` (sequential) or `time-warp`.
     pub engine: &'static str,
     /// Events (messages handled) committed.
     pub committed: u64,
@@ -169,41 +174,67 @@ pub struct PholdReport {
     pub wall_seconds: f64,
     /// Committed events per second.
     pub events_per_second: f64,
+    /// Hash of every object's final counts and random stream position: equal digests, equal runs.
+    pub final_state_digest: String,
+    /// Time Warp's statistics, under Time Warp.
+    pub time_warp: Option<TwStats>,
 }
 
-/// Runs PHOLD on the sequential executor up to time `end`.
-pub fn run_sequential(cfg: PholdConfig, end: f64) -> PholdReport {
-    use crate::kernel::sequential::Sequential;
+/// Runs PHOLD up to time `end`, sequentially or (with `tw`) under Time Warp, one partition per
+/// worker when the partitions match the workers.
+pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> PholdReport {
     let start = std::time::Instant::now();
-    let report = PholdReport {
-        objects: cfg.objects,
-        events_per_object: cfg.events_per_object,
-        remote: cfg.remote,
-        partitions: cfg.partitions,
-        end,
-        engine: "objects",
-        committed: 0,
-        wall_seconds: 0.0,
-        events_per_second: 0.0,
-    };
+    let (objects, events_per_object, remote, partitions) =
+        (cfg.objects, cfg.events_per_object, cfg.remote, cfg.partitions);
     let (model, states) = Phold::new(cfg);
-    let mut ex = Sequential::new(model, states, VTime::at(Key::start(0.0)));
-    let never: Result<(), std::convert::Infallible> = ex.run(end, &mut |_, _, _| Ok(()));
-    let Ok(()) = never;
+    let t0 = VTime::at(Key::start(0.0));
+    let never = |_: &Phold, _: &[PholdState], _: ()| -> Result<(), Infallible> { Ok(()) };
+    let (stats, finals, time_warp) = match tw {
+        None => {
+            let mut ex = Sequential::new(model, states, t0);
+            let Ok(()) = ex.run(end, &mut { never });
+            (ex.stats().clone(), ex.states().to_vec(), None)
+        }
+        Some(c) => {
+            let total = total_workers(&c) as u64;
+            let worker_of: Vec<u32> = (0..objects)
+                .map(|o| (u64::from(o) * total / u64::from(objects)) as u32)
+                .collect();
+            let mut ex = TimeWarp::new(model, states, t0, &worker_of, c);
+            if let Err(TwError::Failed(m)) = ex.run(end, &mut { never }) {
+                panic!("PHOLD under Time Warp failed: {m}");
+            }
+            (ex.stats().clone(), ex.states().to_vec(), Some(ex.tw_stats()))
+        }
+    };
     let wall = start.elapsed().as_secs_f64();
-    let committed = ex.stats().delivered;
+    let committed = stats.delivered;
     PholdReport {
+        objects,
+        events_per_object,
+        remote,
+        partitions,
+        end,
+        engine: if time_warp.is_some() {
+            "time-warp"
+        } else {
+            "objects"
+        },
         committed,
         wall_seconds: wall,
         events_per_second: committed as f64 / wall.max(1e-9),
-        ..report
+        final_state_digest: fnv_hex(
+            finals
+                .iter()
+                .flat_map(|s| [s.handled, s.sends, s.rng.get_word_pos() as u64]),
+        ),
+        time_warp,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::sequential::Sequential;
 
     fn cfg(partitions: u32, remote: f64) -> PholdConfig {
         PholdConfig {
@@ -261,9 +292,6 @@ mod tests {
 #[cfg(test)]
 mod time_warp_tests {
     use super::*;
-    use crate::kernel::sequential::Sequential;
-    use crate::kernel::time_warp::threads::TimeWarp;
-    use crate::kernel::time_warp::TwConfig;
 
     fn cfg(partitions: u32) -> PholdConfig {
         PholdConfig {

@@ -40,8 +40,10 @@ enum Parcel<Msg, S, O> {
     /// Ops for global worker `.0`.
     Ops(usize, Vec<Op<Msg>>),
     /// A committed chunk for rank 0's collector.
-    Chunk(Chunk<S, O>),
+    Chunk(Box<Chunk<S, O>>),
 }
+
+type ChunkOf<M> = Chunk<<M as Model>::State, <M as Model>::Output>;
 
 type ParcelOf<M> = Parcel<<M as Model>::Msg, <M as Model>::State, <M as Model>::Output>;
 
@@ -55,7 +57,7 @@ pub struct MpiFabric<M: Model> {
     reduce: ThreadReduce,
     barrier: Barrier,
     result: Mutex<Reduction>,
-    collector: Mutex<Option<mpsc::Sender<Chunk<M::State, M::Output>>>>,
+    collector: Mutex<Option<mpsc::Sender<ChunkOf<M>>>>,
 }
 
 impl<M: Model> MpiFabric<M>
@@ -70,7 +72,7 @@ where
         rank: usize,
         ranks: usize,
         per_rank: usize,
-        collector: Option<mpsc::Sender<Chunk<M::State, M::Output>>>,
+        collector: Option<mpsc::Sender<ChunkOf<M>>>,
     ) -> Self {
         MpiFabric {
             rank,
@@ -100,7 +102,7 @@ where
             }
             Parcel::Chunk(c) => {
                 if let Some(tx) = &*self.collector.lock().expect("no thread panicked") {
-                    let _ = tx.send(c);
+                    let _ = tx.send(*c);
                 }
             }
         }
@@ -197,9 +199,10 @@ where
 
     fn commit(&self, chunk: Chunk<M::State, M::Output>) {
         if self.rank == 0 {
-            self.deliver(Parcel::Chunk(chunk));
+            self.deliver(Parcel::Chunk(Box::new(chunk)));
         } else {
-            self.outgoing.lock().expect("no thread panicked")[0].push(Parcel::Chunk(chunk));
+            self.outgoing.lock().expect("no thread panicked")[0]
+                .push(Parcel::Chunk(Box::new(chunk)));
         }
     }
 }
