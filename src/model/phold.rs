@@ -16,10 +16,10 @@ use crate::kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
 use crate::kernel::time_warp::{TwConfig, TwStats};
 use crate::kernel::{Ctx, Envelope, Model, VTime};
 use crate::output::fnv_hex;
-use std::convert::Infallible;
 use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::convert::Infallible;
 
 /// PHOLD's parameters.
 #[derive(Clone, Debug)]
@@ -184,8 +184,12 @@ pub struct PholdReport {
 /// worker when the partitions match the workers.
 pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> PholdReport {
     let start = std::time::Instant::now();
-    let (objects, events_per_object, remote, partitions) =
-        (cfg.objects, cfg.events_per_object, cfg.remote, cfg.partitions);
+    let (objects, events_per_object, remote, partitions) = (
+        cfg.objects,
+        cfg.events_per_object,
+        cfg.remote,
+        cfg.partitions,
+    );
     let (model, states) = Phold::new(cfg);
     let t0 = VTime::at(Key::start(0.0));
     let never = |_: &Phold, _: &[PholdState], _: ()| -> Result<(), Infallible> { Ok(()) };
@@ -204,7 +208,11 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> PholdReport {
             if let Err(TwError::Failed(m)) = ex.run(end, &mut { never }) {
                 panic!("PHOLD under Time Warp failed: {m}");
             }
-            (ex.stats().clone(), ex.states().to_vec(), Some(ex.tw_stats()))
+            (
+                ex.stats().clone(),
+                ex.states().to_vec(),
+                Some(ex.tw_stats()),
+            )
         }
     };
     let wall = start.elapsed().as_secs_f64();

@@ -222,7 +222,7 @@ pub struct Chunk<S, O> {
     pub worker: usize,
     /// The round.
     pub round: u64,
-    /// Batches committed in this round, in (time, object) order.
+    /// Batches committed in this round that carry output or observed states, in any order.
     pub batches: Vec<Committed<S, O>>,
     /// Set on the worker's last chunk of a run: its statistics.
     pub last: Option<(TwStats, MessageStats, u64)>,
@@ -873,8 +873,8 @@ impl<M: Model> Worker<M> {
         }
     }
 
-    /// Commits every batch before `gvt`: frees its saved state and messages, and returns it
-    /// for the collector in (time, object) order.
+    /// Commits every batch before `gvt`: frees its saved state and messages, and returns those
+    /// the collector needs (observed states, output), in no particular order.
     fn fossil_collect(&mut self, model: &M, gvt: f64) -> Vec<Committed<M::State, M::Output>> {
         let mut out = Vec::new();
         for lp in &mut self.lps {
@@ -901,12 +901,15 @@ impl<M: Model> Worker<M> {
                 for uid in &d.inputs {
                     self.entries.remove(uid);
                 }
-                out.push(Committed {
-                    time: d.time,
-                    obj: lp.id,
-                    state,
-                    output: d.output,
-                });
+                // the collector needs only what its sinks see
+                if state.is_some() || !d.output.is_empty() {
+                    out.push(Committed {
+                        time: d.time,
+                        obj: lp.id,
+                        state,
+                        output: d.output,
+                    });
+                }
             }
             if lp.sends.len() > lp.sweep_at {
                 lp.sends.retain(|_, s| s.time.t() >= gvt);
@@ -918,7 +921,6 @@ impl<M: Model> Worker<M> {
             self.entries.retain(|_, e| e.t >= gvt);
             self.sweep_at = 2 * self.entries.len().max(512);
         }
-        out.sort_by(|a, b| a.time.cmp(&b.time).then(a.obj.cmp(&b.obj)));
         self.samples
             .push(self.uncommitted as u64 + self.entries.len() as u64);
         out

@@ -180,10 +180,22 @@ impl<M: Model> Collector<M> {
             if failed.is_some() {
                 continue;
             }
-            let mut batches: Vec<Committed<M::State, M::Output>> =
-                chunks.into_iter().flat_map(|c| c.batches).collect();
-            batches.sort_by(|a, b| a.time.cmp(&b.time).then(a.obj.cmp(&b.obj)));
-            for c in batches {
+            let mut batches: Vec<Option<Committed<M::State, M::Output>>> = chunks
+                .into_iter()
+                .flat_map(|c| c.batches)
+                .map(Some)
+                .collect();
+            // (time, object) names one batch: sort a permutation, not the records
+            let mut order: Vec<usize> = (0..batches.len()).collect();
+            order.sort_unstable_by(|&i, &j| {
+                let (a, b) = (batches[i].as_ref(), batches[j].as_ref());
+                let (a, b) = (a.expect("unmoved"), b.expect("unmoved"));
+                a.time.cmp(&b.time).then(a.obj.cmp(&b.obj))
+            });
+            for c in order
+                .into_iter()
+                .map(|i| batches[i].take().expect("taken once"))
+            {
                 if let Some(state) = c.state {
                     self.states[c.obj as usize] = state;
                 }
