@@ -1,0 +1,144 @@
+//! Time Warp across MPI ranks (cargo feature `mpi`, OpenMPI's `mpirun` on the path): on 2 and 3
+//! ranks on loopback, with and without chaos, pool and PHOLD give the sequential objects
+//! engine's trace and final-state digest, bit for bit.
+#![cfg(feature = "mpi")]
+
+use std::path::Path;
+use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_poolsim");
+
+/// Runs poolsim with `args` (under `mpirun -np ranks` when `ranks` is given) and returns its
+/// standard output, which must be one JSON object.
+fn poolsim(ranks: Option<usize>, chaos: Option<u64>, args: &[&str]) -> serde_json::Value {
+    let mut cmd = match ranks {
+        None => Command::new(BIN),
+        Some(r) => {
+            let mut c = Command::new("mpirun");
+            c.args([
+                "--allow-run-as-root",
+                "--oversubscribe",
+                "-np",
+                &r.to_string(),
+            ]);
+            if let Some(seed) = chaos {
+                c.args(["-x", &format!("POOLSIM_CHAOS={seed}")]);
+            }
+            c.arg(BIN);
+            c
+        }
+    };
+    let out = cmd.args(args).output().expect("mpirun and poolsim start");
+    assert!(
+        out.status.success(),
+        "{args:?} on {ranks:?} ranks: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "{args:?}: not one JSON object ({e}): {}",
+            String::from_utf8_lossy(&out.stdout)
+        )
+    })
+}
+
+/// The sequential objects engine's trace and digest against Time Warp's on 2 and 3 ranks.
+fn assert_same(scenario: &str, extra: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let want_trace = dir.path().join("want.jsonl");
+    let mut args = vec!["run", scenario, "--json", "--quiet"];
+    args.extend_from_slice(extra);
+    let mut seq = args.clone();
+    seq.extend([
+        "--engine",
+        "objects",
+        "--trace",
+        want_trace.to_str().unwrap(),
+    ]);
+    let want = poolsim(None, None, &seq);
+    for (ranks, workers, chaos) in [
+        (2, "1", None),
+        (3, "1", None),
+        (2, "2", Some(9)),
+        (3, "1", Some(4)),
+    ] {
+        let got_trace = dir.path().join(format!("got-{ranks}-{workers}.jsonl"));
+        let mut tw = args.clone();
+        tw.extend(["--engine", "time-warp", "--workers", workers]);
+        tw.extend(["--trace", got_trace.to_str().unwrap()]);
+        let got = poolsim(Some(ranks), chaos, &tw);
+        let what = format!("{scenario} {extra:?} on {ranks} ranks x {workers}, chaos {chaos:?}");
+        assert_eq!(
+            got["final_state_digest"], want["final_state_digest"],
+            "{what}"
+        );
+        assert_eq!(got["messages"], want["messages"], "{what}");
+        assert_eq!(got["time_warp"]["ranks"], ranks, "{what}");
+        assert_eq!(read(&got_trace), read(&want_trace), "{what}: traces differ");
+    }
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap()
+}
+
+#[test]
+fn sectored_gas_on_ranks() {
+    assert_same("gas", &["--balls", "64", "--sectors", "4"]);
+}
+
+#[test]
+fn the_break_on_ranks() {
+    assert_same("pool", &[]);
+    assert_same("pool", &["--sectors", "2"]);
+}
+
+#[test]
+fn hard_cases_on_ranks() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            assert_same(path.to_str().unwrap(), &["--sectors", "2"]);
+            n += 1;
+        }
+    }
+    assert!(n >= 10);
+}
+
+#[test]
+fn phold_on_ranks() {
+    let args = |engine: &str| {
+        vec![
+            "phold",
+            "--objects",
+            "256",
+            "--end",
+            "20",
+            "--partitions",
+            "3",
+            "--json",
+            "--engine",
+            engine,
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>()
+    };
+    let seq = args("objects");
+    let seq: Vec<&str> = seq.iter().map(String::as_str).collect();
+    let want = poolsim(None, None, &seq);
+    for (ranks, chaos) in [(2, None), (3, None), (3, Some(2))] {
+        let tw = args("time-warp");
+        let mut tw: Vec<&str> = tw.iter().map(String::as_str).collect();
+        tw.extend(["--workers", "1"]);
+        let got = poolsim(Some(ranks), chaos, &tw);
+        assert_eq!(
+            got["final_state_digest"], want["final_state_digest"],
+            "{ranks} ranks"
+        );
+        assert_eq!(got["committed"], want["committed"]);
+        assert_eq!(got["time_warp"]["ranks"], ranks);
+    }
+}
