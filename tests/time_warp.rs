@@ -149,3 +149,42 @@ fn a_tight_memory_budget_rolls_back_and_stays_exact() {
     let tw = &got.summary["time_warp"];
     assert!(tw["artificial_rollbacks"].as_u64().unwrap() > 0, "{tw}");
 }
+
+#[test]
+fn memory_stays_flat_over_many_gvt_rounds() {
+    use poolsim::kernel::time_warp::threads::TimeWarp;
+    use poolsim::kernel::VTime;
+    use poolsim::model::phold::{Phold, PholdConfig};
+    use poolsim::vtime::Key;
+    let cfg = PholdConfig {
+        objects: 512,
+        events_per_object: 8,
+        remote: 0.2,
+        partitions: 2,
+        lookahead: 0.05,
+        mean: 1.0,
+        seed: 3,
+    };
+    let (model, states) = Phold::new(cfg);
+    let worker_of: Vec<u32> = (0..512).map(|o| o / 256).collect();
+    let tw = TwConfig {
+        workers: 2,
+        gvt_interval: 512,
+        ..TwConfig::default()
+    };
+    let mut ex = TimeWarp::new(model, states, VTime::at(Key::start(0.0)), &worker_of, tw);
+    ex.run::<()>(200.0, &mut |_, _, _| Ok(())).unwrap();
+    let stats = ex.tw_stats();
+    assert!(stats.gvt_rounds >= 100, "{stats:?}");
+    assert!(stats.committed > 500_000, "{stats:?}");
+    for samples in ex.memory_samples() {
+        // held messages plus saved states after each GVT round: after warm-up (the first tenth)
+        // the second half never holds much more than the first
+        let n = samples.len();
+        let early = samples[n / 10..n / 2].iter().max().unwrap();
+        let late = samples[n / 2..].iter().max().unwrap();
+        assert!(*late as f64 <= 1.5 * *early as f64, "early {early}, late {late}");
+        // and far less than the events committed: fossil collection frees them
+        assert!((*late as u64) < stats.committed / 20, "{late} vs {stats:?}");
+    }
+}
