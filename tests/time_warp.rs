@@ -183,7 +183,10 @@ fn memory_stays_flat_over_many_gvt_rounds() {
         let n = samples.len();
         let early = samples[n / 10..n / 2].iter().max().unwrap();
         let late = samples[n / 2..].iter().max().unwrap();
-        assert!(*late as f64 <= 1.5 * *early as f64, "early {early}, late {late}");
+        assert!(
+            *late as f64 <= 1.5 * *early as f64,
+            "early {early}, late {late}"
+        );
         // and far less than the events committed: fossil collection frees them
         assert!((*late as u64) < stats.committed / 20, "{late} vs {stats:?}");
     }

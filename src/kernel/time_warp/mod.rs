@@ -350,6 +350,8 @@ struct Lp<M: Model> {
     sends: FxHashMap<u64, Sent>,
     /// Size of `sends` past which fossil collection sweeps it (amortized: doubled each sweep).
     sweep_at: usize,
+    /// Whether it is in its worker's list of objects with uncommitted batches.
+    active: bool,
 }
 
 impl<M: Model> Lp<M> {
@@ -437,6 +439,8 @@ pub struct Worker<M: Model> {
     fault: Option<String>,
     /// Size of `entries` past which fossil collection sweeps out cancelled messages before GVT.
     sweep_at: usize,
+    /// Local objects with uncommitted batches (fossil collection visits only these).
+    active: Vec<u32>,
 }
 
 /// Why a worker stopped early.
@@ -469,6 +473,7 @@ impl<M: Model> Worker<M> {
                     history: VecDeque::new(),
                     sends: FxHashMap::default(),
                     sweep_at: 64,
+                    active: false,
                 })
                 .collect(),
             placement,
@@ -495,6 +500,7 @@ impl<M: Model> Worker<M> {
             samples: Vec::new(),
             fault: None,
             sweep_at: 1024,
+            active: Vec::new(),
         }
     }
 
@@ -758,6 +764,10 @@ impl<M: Model> Worker<M> {
                 sign: 1,
             });
         }
+        if !lp.active {
+            lp.active = true;
+            self.active.push(li as u32);
+        }
         lp.history.push_back(Done {
             time,
             pre_state,
@@ -877,7 +887,9 @@ impl<M: Model> Worker<M> {
     /// the collector needs (observed states, output), in no particular order.
     fn fossil_collect(&mut self, model: &M, gvt: f64) -> Vec<Committed<M::State, M::Output>> {
         let mut out = Vec::new();
-        for lp in &mut self.lps {
+        let mut still = Vec::with_capacity(self.active.len());
+        for &li in &self.active {
+            let lp = &mut self.lps[li as usize];
             let observed = model.observed(lp.id);
             while lp.history.front().is_some_and(|d| d.time.t() < gvt) {
                 let d = lp.history.pop_front().expect("a batch to commit");
@@ -915,7 +927,13 @@ impl<M: Model> Worker<M> {
                 lp.sends.retain(|_, s| s.time.t() >= gvt);
                 lp.sweep_at = 2 * lp.sends.len().max(32);
             }
+            if lp.history.is_empty() {
+                lp.active = false;
+            } else {
+                still.push(li);
+            }
         }
+        self.active = still;
         if self.entries.len() > self.sweep_at {
             // cancelled messages before GVT can never come back to life
             self.entries.retain(|_, e| e.t >= gvt);
