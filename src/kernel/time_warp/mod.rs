@@ -101,6 +101,12 @@ pub struct TwStats {
     pub peak_uncommitted: u64,
     /// The most messages (entries) one worker held at once.
     pub peak_entries: u64,
+    /// The most messages plus saved states one worker held after a GVT round, over the first
+    /// half of the run's rounds past warm-up (the first tenth).
+    pub held_early: u64,
+    /// The same over the second half: about `held_early` when fossil collection keeps memory
+    /// flat.
+    pub held_late: u64,
 }
 
 impl TwStats {
@@ -127,6 +133,8 @@ impl TwStats {
         self.gvt_rounds = self.gvt_rounds.max(o.gvt_rounds);
         self.peak_uncommitted = self.peak_uncommitted.max(o.peak_uncommitted);
         self.peak_entries = self.peak_entries.max(o.peak_entries);
+        self.held_early = self.held_early.max(o.held_early);
+        self.held_late = self.held_late.max(o.held_late);
     }
 }
 
@@ -246,8 +254,6 @@ pub trait Fabric<M: Model>: Sync {
 
 /// A message received and not yet committed.
 struct Entry<Msg> {
-    /// Its simulation time.
-    t: f64,
     /// Positives minus anti-messages: 1 when the message is here and not annulled.
     pos: i8,
     /// Model cancellations minus their undoing.
@@ -437,8 +443,9 @@ pub struct Worker<M: Model> {
     samples: Vec<u64>,
     /// A failure found while committing; the run stops at the next GVT round.
     fault: Option<String>,
-    /// Size of `entries` past which fossil collection sweeps out cancelled messages before GVT.
-    sweep_at: usize,
+    /// Messages that stopped being live (cancelled, annulled), with their times: fossil
+    /// collection frees those before GVT.
+    graveyard: Vec<(f64, u64)>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
 }
@@ -499,7 +506,7 @@ impl<M: Model> Worker<M> {
             committed_stats: MessageStats::default(),
             samples: Vec::new(),
             fault: None,
-            sweep_at: 1024,
+            graveyard: Vec::new(),
             active: Vec::new(),
         }
     }
@@ -602,7 +609,6 @@ impl<M: Model> Worker<M> {
             Op::Anti { uid, time, .. } | Op::Cancel { uid, time, .. } => (*uid, time.clone()),
         };
         let e = self.entries.entry(uid).or_insert(Entry {
-            t: time.t(),
             pos: 0,
             cancels: 0,
             p: None,
@@ -623,6 +629,9 @@ impl<M: Model> Worker<M> {
         let after = e.live();
         if e.pos == 0 && e.cancels == 0 {
             self.entries.remove(&uid);
+        }
+        if before && !after {
+            self.graveyard.push((time.t(), uid));
         }
         if before != after {
             let li = self.placement.local(to);
@@ -934,11 +943,18 @@ impl<M: Model> Worker<M> {
             }
         }
         self.active = still;
-        if self.entries.len() > self.sweep_at {
-            // cancelled messages before GVT can never come back to life
-            self.entries.retain(|_, e| e.t >= gvt);
-            self.sweep_at = 2 * self.entries.len().max(512);
-        }
+        // cancelled or annulled messages before GVT can never come back to life
+        let entries = &mut self.entries;
+        self.graveyard.retain(|&(t, uid)| {
+            if t < gvt {
+                if entries.get(&uid).is_some_and(|e| !e.live()) {
+                    entries.remove(&uid);
+                }
+                false
+            } else {
+                true
+            }
+        });
         self.samples
             .push(self.uncommitted as u64 + self.entries.len() as u64);
         out
@@ -1030,6 +1046,10 @@ impl<M: Model> Worker<M> {
             Err(Stop::Failed(m)) => Some(m.clone()),
             _ => None,
         };
+        let n = self.samples.len();
+        let max = |r: std::ops::Range<usize>| self.samples[r].iter().copied().max().unwrap_or(0);
+        self.stats.held_early = max(n / 10..n / 2);
+        self.stats.held_late = max(n / 2..n);
         fabric.commit(Chunk {
             worker: self.index,
             round: u64::MAX,
