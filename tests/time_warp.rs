@@ -188,6 +188,6 @@ fn memory_stays_flat_over_many_gvt_rounds() {
             "early {early}, late {late}"
         );
         // and far less than the events committed: fossil collection frees them
-        assert!((*late as u64) < stats.committed / 20, "{late} vs {stats:?}");
+        assert!(*late < stats.committed / 20, "{late} vs {stats:?}");
     }
 }
