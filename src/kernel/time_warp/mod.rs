@@ -41,6 +41,7 @@ use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
+use smallvec::SmallVec;
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, VecDeque};
 
@@ -167,6 +168,9 @@ pub enum Op<Msg> {
         time: VTime,
         /// 1 to cancel, -1 to undo.
         sign: i8,
+        /// The simulation time of the cancelling batch: once GVT passes it, the cancellation
+        /// is final.
+        at: f64,
     },
 }
 
@@ -256,8 +260,8 @@ pub trait Fabric<M: Model>: Sync {
 struct Entry<Msg> {
     /// Positives minus anti-messages: 1 when the message is here and not annulled.
     pos: i8,
-    /// Model cancellations minus their undoing.
-    cancels: i32,
+    /// Model cancellations minus their undoing, by the time of the cancelling batch.
+    cancels: SmallVec<[(f64, i32); 1]>,
     /// The message, while `pos` is 1.
     p: Option<Pending<Msg>>,
     /// Whether a batch not rolled back has handled it.
@@ -266,7 +270,29 @@ struct Entry<Msg> {
 
 impl<Msg> Entry<Msg> {
     fn live(&self) -> bool {
-        self.pos == 1 && self.cancels == 0
+        self.pos == 1 && self.cancels.is_empty()
+    }
+
+    /// Counts a cancellation by a batch at `at` (`sign` 1) or its undoing (-1).
+    fn cancel(&mut self, at: f64, sign: i8) {
+        match self
+            .cancels
+            .iter()
+            .position(|c| c.0.to_bits() == at.to_bits())
+        {
+            Some(k) => {
+                self.cancels[k].1 += i32::from(sign);
+                if self.cancels[k].1 == 0 {
+                    self.cancels.swap_remove(k);
+                }
+            }
+            None => self.cancels.push((at, i32::from(sign))),
+        }
+    }
+
+    /// Whether it is dead for good once GVT is `gvt`: here and cancelled by a committed batch.
+    fn dead_for_good(&self, gvt: f64) -> bool {
+        self.pos == 1 && self.cancels.iter().any(|&(at, n)| n > 0 && at < gvt)
     }
 }
 
@@ -327,6 +353,7 @@ impl Ord for Item {
 #[derive(Clone, Debug)]
 struct Sent {
     uid: u64,
+    seq: u64,
     to: u32,
     time: VTime,
 }
@@ -443,8 +470,8 @@ pub struct Worker<M: Model> {
     samples: Vec<u64>,
     /// A failure found while committing; the run stops at the next GVT round.
     fault: Option<String>,
-    /// Messages that stopped being live (cancelled, annulled), with their times: fossil
-    /// collection frees those before GVT.
+    /// Messages left dead (cancelled, annulled), with their times: fossil collection frees them
+    /// once nothing can revive them.
     graveyard: Vec<(f64, u64)>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
@@ -528,6 +555,7 @@ impl<M: Model> Worker<M> {
                     p.env.seq,
                     Sent {
                         uid,
+                        seq: p.env.seq,
                         to: p.to,
                         time: p.time.clone(),
                     },
@@ -610,7 +638,7 @@ impl<M: Model> Worker<M> {
         };
         let e = self.entries.entry(uid).or_insert(Entry {
             pos: 0,
-            cancels: 0,
+            cancels: SmallVec::new(),
             p: None,
             processed: false,
         });
@@ -624,13 +652,12 @@ impl<M: Model> Worker<M> {
                 e.pos -= 1;
                 e.p = None;
             }
-            Op::Cancel { sign, .. } => e.cancels += i32::from(sign),
+            Op::Cancel { sign, at, .. } => e.cancel(at, sign),
         }
         let after = e.live();
-        if e.pos == 0 && e.cancels == 0 {
+        if e.pos == 0 && e.cancels.is_empty() {
             self.entries.remove(&uid);
-        }
-        if before && !after {
+        } else if !after {
             self.graveyard.push((time.t(), uid));
         }
         if before != after {
@@ -682,6 +709,7 @@ impl<M: Model> Worker<M> {
                     to: c.to,
                     time: c.time,
                     sign: -1,
+                    at: d.time.t(),
                 });
             }
         }
@@ -749,6 +777,7 @@ impl<M: Model> Worker<M> {
             let uid = lp.next_uid();
             let s = Sent {
                 uid,
+                seq: p.env.seq,
                 to: p.to,
                 time: p.time.clone(),
             };
@@ -771,6 +800,7 @@ impl<M: Model> Worker<M> {
                 to: c.to,
                 time: c.time.clone(),
                 sign: 1,
+                at: time.t(),
             });
         }
         if !lp.active {
@@ -865,6 +895,11 @@ impl<M: Model> Worker<M> {
         if let Some(c) = &self.chaos {
             for (_, op) in &c.held {
                 m = m.min(op.time().t());
+                // a held cancellation keeps GVT below its batch, so that fossil collection
+                // cannot take the message it counts on for cancelled for good
+                if let Op::Cancel { at, .. } = op {
+                    m = m.min(*at);
+                }
             }
         }
         m
@@ -922,6 +957,10 @@ impl<M: Model> Worker<M> {
                 for uid in &d.inputs {
                     self.entries.remove(uid);
                 }
+                // a committed cancellation is final: its message needs no name any more
+                for c in &d.cancels {
+                    lp.sends.remove(&c.seq);
+                }
                 // the collector needs only what its sinks see
                 if state.is_some() || !d.output.is_empty() {
                     out.push(Committed {
@@ -943,18 +982,27 @@ impl<M: Model> Worker<M> {
             }
         }
         self.active = still;
-        // cancelled or annulled messages before GVT can never come back to life
+        // dead messages whose cancellation is committed can never come back to life
         let entries = &mut self.entries;
-        self.graveyard.retain(|&(t, uid)| {
-            if t < gvt {
-                if entries.get(&uid).is_some_and(|e| !e.live()) {
-                    entries.remove(&uid);
-                }
-                false
-            } else {
-                true
+        let graveyard = &mut self.graveyard;
+        graveyard.retain(|&(t, uid)| {
+            // a message cancelled by a committed batch, or any dead message before GVT (nothing
+            // for it can be in flight then), is dead for ever
+            let gone = |e: &Entry<M::Msg>| !e.live() && (t < gvt || e.dead_for_good(gvt));
+            if entries.get(&uid).is_some_and(gone) {
+                entries.remove(&uid);
             }
+            t >= gvt && entries.contains_key(&uid)
         });
+        // heap items of freed messages wait for their time; drop them when they outnumber the rest
+        if self.heap.len() > 2 * self.entries.len() + 1024 {
+            let entries = &self.entries;
+            self.heap.retain(|it| {
+                entries
+                    .get(&it.uid)
+                    .is_some_and(|e| e.live() && !e.processed)
+            });
+        }
         self.samples
             .push(self.uncommitted as u64 + self.entries.len() as u64);
         out
