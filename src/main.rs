@@ -94,7 +94,7 @@ struct RunArgs {
     #[arg(long)]
     workers: Option<usize>,
     /// Time Warp's optimism window: no batch later than GVT plus this (simulation time).
-    #[arg(long = "tw-window")]
+    #[arg(long = "tw-window", allow_negative_numbers = true)]
     tw_window: Option<f64>,
     /// Time Warp's memory budget: uncommitted batches per worker.
     #[arg(long = "tw-memory")]

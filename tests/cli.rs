@@ -642,3 +642,87 @@ fn every_scenario_file_passes_check() {
         assert_eq!(v["checked"], true);
     }
 }
+
+#[test]
+fn time_warp_runs_checked_and_reports_its_statistics() {
+    let v = success_json(&[
+        "run",
+        "gas",
+        "--balls",
+        "64",
+        "--sectors",
+        "4",
+        "--engine",
+        "time-warp",
+        "--workers",
+        "2",
+        "--check",
+        "--json",
+    ]);
+    assert_eq!(v["engine"], "time-warp");
+    let tw = &v["time_warp"];
+    assert_eq!(u(&tw["workers"]), 2);
+    assert_eq!(u(&tw["ranks"]), 1);
+    assert!(u(&tw["processed"]) >= u(&tw["committed"]));
+    assert_eq!(
+        f(&tw["efficiency"]),
+        u(&tw["committed"]) as f64 / u(&tw["processed"]) as f64
+    );
+    let seq = success_json(&[
+        "run",
+        "gas",
+        "--balls",
+        "64",
+        "--sectors",
+        "4",
+        "--engine",
+        "objects",
+        "--json",
+    ]);
+    assert_eq!(v["final_state_digest"], seq["final_state_digest"]);
+}
+
+#[test]
+fn time_warp_flags_are_checked() {
+    let tw = ["run", "gas", "--engine", "time-warp"];
+    for (extra, field) in [
+        (&["--workers", "0"][..], "--workers"),
+        (&["--tw-memory", "3"][..], "--tw-memory"),
+        (&["--tw-window", "-1"][..], "--tw-window"),
+        (&["--gvt-interval", "0"][..], "--gvt-interval"),
+    ] {
+        let args: Vec<&str> = tw.iter().chain(extra).copied().collect();
+        assert!(bad_usage(&args).contains(field), "{args:?}");
+    }
+    let line = bad_usage(&["run", "gas", "--workers", "2"]);
+    assert!(line.contains("--workers"), "{line}");
+    let out = Command::new(env!("CARGO_BIN_EXE_poolsim"))
+        .args(["run", "gas", "--engine", "time-warp"])
+        .env("POOLSIM_CHAOS", "lots")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("POOLSIM_CHAOS"));
+}
+
+#[test]
+fn a_memory_budget_too_small_for_one_instant_is_a_clear_error() {
+    let line = failure(
+        &[
+            "run",
+            "gas",
+            "--balls",
+            "400",
+            "--sectors",
+            "5",
+            "--engine",
+            "time-warp",
+            "--workers",
+            "2",
+            "--tw-memory",
+            "16",
+        ],
+        1,
+    );
+    assert!(line.contains("--tw-memory"), "{line}");
+}
