@@ -191,3 +191,34 @@ fn memory_stays_flat_over_many_gvt_rounds() {
         assert!(*late < stats.committed / 20, "{late} vs {stats:?}");
     }
 }
+
+#[test]
+fn a_failing_sink_stops_every_worker_with_its_error() {
+    use poolsim::engine::{Event, Observer, RunError, World};
+    /// Fails at the tenth committed event.
+    struct FailAt(u32);
+    impl Observer for FailAt {
+        fn on_event(&mut self, _: &Event, _: &dyn World) -> Result<(), RunError> {
+            self.0 += 1;
+            if self.0 == 10 {
+                return Err(RunError::Output("disk full".into()));
+            }
+            Ok(())
+        }
+    }
+    let s = gas(64, 2);
+    for workers in [1, 2, 3] {
+        let cfg = RunConfig {
+            engine: time_warp(Some(SectorChoice::Grid(4, 4)), workers, Some(1)),
+            until: s.until,
+            check: false,
+            span: Default::default(),
+        };
+        let mut obs = FailAt(0);
+        match execute(&s, &cfg, &mut obs) {
+            Err(RunError::Output(m)) => assert_eq!(m, "disk full"),
+            other => panic!("{workers} workers: {other:?}"),
+        }
+        assert_eq!(obs.0, 10, "no event after the failure reached the sink");
+    }
+}
