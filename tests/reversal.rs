@@ -42,6 +42,23 @@ fn thesis_4_7_returns_every_ball_to_its_start() {
         assert_eq!(a.events, d.events, "{k} sectors per side");
         assert_eq!(a.max_position_error, d.max_position_error);
     }
+    // Time Warp, plain and sectored, on 2 workers with chaos: the same reversal, bit for bit
+    for sectors in [None, Some(poolsim::run::SectorChoice::Grid(2, 2))] {
+        let tw = poolsim::kernel::time_warp::TwConfig {
+            workers: 2,
+            chaos: Some(11),
+            ..Default::default()
+        };
+        let engine = EngineKind::TimeWarp {
+            tw,
+            delay: poolsim::model::pool::NvDelay::Exact,
+            sectors,
+        };
+        let e = reverse(&s, engine, 3.0, true).unwrap();
+        assert_eq!(a.events, e.events, "time warp {sectors:?}");
+        assert_eq!(a.max_position_error, e.max_position_error);
+        assert_eq!(a.max_velocity_error, e.max_velocity_error);
+    }
     let c = reverse(&s, EngineKind::TimeStep { dt: 1e-3 }, 3.0, false).unwrap();
     assert!(c.max_position_error < 1e-3, "{}", c.max_position_error);
 }

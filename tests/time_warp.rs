@@ -222,3 +222,43 @@ fn a_failing_sink_stops_every_worker_with_its_error() {
         assert_eq!(obs.0, 10, "no event after the failure reached the sink");
     }
 }
+
+#[test]
+fn the_projectors_frames_are_the_sequential_ones() {
+    use poolsim::engine::{Event, Frame, Observer, RunError, Span, Table, World};
+    #[derive(Default)]
+    struct Frames(Vec<Frame>);
+    impl Observer for Frames {
+        fn on_event(&mut self, _: &Event, _: &dyn World) -> Result<(), RunError> {
+            Ok(())
+        }
+        fn on_frame(&mut self, f: &Frame, _: &Table) -> Result<(), RunError> {
+            self.0.push(f.clone());
+            Ok(())
+        }
+    }
+    let s = builtin::build("plate1", &builtin::Params::default()).unwrap();
+    let frames = |engine| {
+        let cfg = RunConfig {
+            engine,
+            until: s.until,
+            check: false,
+            span: Span {
+                frame_time: Some(0.1),
+                ..Span::default()
+            },
+        };
+        let mut obs = Frames::default();
+        execute(&s, &cfg, &mut obs).unwrap();
+        obs.0
+    };
+    let want = frames(sequential(None));
+    assert!(want.len() > 20, "{}", want.len());
+    for workers in [2, 3] {
+        assert_eq!(
+            frames(time_warp(None, workers, Some(4))),
+            want,
+            "{workers} workers"
+        );
+    }
+}
