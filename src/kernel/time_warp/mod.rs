@@ -54,7 +54,8 @@ pub struct TwConfig {
     pub chaos: Option<u64>,
     /// Batches a worker runs between GVT rounds.
     pub gvt_interval: u32,
-    /// Optimism window: no batch later than GVT plus this (simulation time).
+    /// Optimism window: no batch later than GVT plus this (simulation time); `None` adapts it
+    /// to four times the GVT advance of the last round.
     pub window: Option<f64>,
     /// Uncommitted batches a worker may hold before it rolls its furthest objects back and
     /// runs only batches at GVT; past four times this, the run stops with an error.
@@ -463,6 +464,8 @@ pub struct Worker<M: Model> {
     received_ops: i64,
     uncommitted: usize,
     gvt: f64,
+    /// The optimism window when none is set: a few GVT rounds' worth of progress.
+    auto_window: f64,
     round: u64,
     stats: TwStats,
     committed_stats: MessageStats,
@@ -524,6 +527,7 @@ impl<M: Model> Worker<M> {
             received_ops: 0,
             uncommitted: 0,
             gvt: f64::NEG_INFINITY,
+            auto_window: f64::INFINITY,
             round: 0,
             stats: TwStats {
                 workers: 1,
@@ -1023,7 +1027,7 @@ impl<M: Model> Worker<M> {
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
-            let window = cfg.window.map_or(f64::INFINITY, |w| self.gvt + w);
+            let window = self.gvt + cfg.window.unwrap_or(self.auto_window);
             let mut limit = until.min(window);
             let burst = match &mut self.chaos {
                 Some(c) => c.rng.gen_range(1..64u32),
@@ -1073,6 +1077,10 @@ impl<M: Model> Worker<M> {
                 }
                 Err(s) => break Err(s),
                 Ok(gvt) => {
+                    // without a set window, run at most a few rounds' worth of GVT progress ahead
+                    if self.gvt.is_finite() && gvt.is_finite() && gvt > self.gvt {
+                        self.auto_window = 4.0 * (gvt - self.gvt);
+                    }
                     self.gvt = gvt;
                     let batches = self.fossil_collect(model, gvt);
                     self.round += 1;
