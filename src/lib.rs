@@ -5,7 +5,8 @@
 //! - [`geometry`] and [`physics`]: pure functions of trajectories (thesis ch. 3);
 //! - [`scenario`]: tables and balls from TOML or built-in generators, validated once;
 //! - [`vtime`]: the lexicographic virtual time that orders simultaneous events exactly;
-//! - [`kernel`]: a generic message-passing kernel (objects, batches, cancellation, statistics);
+//! - [`kernel`]: a generic message-passing kernel (objects, batches, cancellation, statistics),
+//!   run in order or optimistically in parallel by Time Warp (threads, MPI ranks);
 //! - [`model`]: the pool objects and PHOLD as kernel models;
 //! - [`engine`]: the event-list, time-step and objects engines;
 //! - [`check`]: invariants checked while a run goes (`--check`);
