@@ -336,20 +336,7 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
             }
             None
         }
-        "time-warp" => {
-            let mut tw = TwConfig {
-                workers: std::thread::available_parallelism().map_or(1, |n| n.get()),
-                chaos: time_warp::chaos_from_env().map_err(usage)?,
-                ..TwConfig::default()
-            };
-            if let Some(w) = a.workers {
-                if !(1..=1024).contains(&w) {
-                    return Err(usage(format!("--workers: must be 1 to 1024, got {w}")));
-                }
-                tw.workers = w;
-            }
-            Some(tw)
-        }
+        "time-warp" => Some(tw_workers(a.workers)?),
         other => {
             return Err(usage(format!(
                 "--engine: PHOLD runs on objects or time-warp, not `{other}`"
@@ -627,19 +614,26 @@ fn start_mpi() -> Result<Option<mpi::environment::Universe>, Failure> {
     }
 }
 
-/// Time Warp's settings from the flags and `POOLSIM_CHAOS`.
-fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
+/// Time Warp's default settings with `--workers` (default: this machine's cores) and
+/// `POOLSIM_CHAOS`.
+fn tw_workers(workers: Option<usize>) -> Result<TwConfig, Failure> {
     let mut tw = TwConfig {
         workers: std::thread::available_parallelism().map_or(1, |n| n.get()),
         chaos: time_warp::chaos_from_env().map_err(usage)?,
         ..TwConfig::default()
     };
-    if let Some(w) = a.workers {
+    if let Some(w) = workers {
         if !(1..=1024).contains(&w) {
             return Err(usage(format!("--workers: must be 1 to 1024, got {w}")));
         }
         tw.workers = w;
     }
+    Ok(tw)
+}
+
+/// Time Warp's settings from the flags and `POOLSIM_CHAOS`.
+fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
+    let mut tw = tw_workers(a.workers)?;
     if let Some(w) = a.tw_window {
         if !(w.is_finite() && w > 0.0) {
             return Err(usage(format!(
