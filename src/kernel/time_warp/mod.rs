@@ -430,11 +430,6 @@ impl Placement {
         self.place[o as usize].1 as usize
     }
 
-    /// Objects on worker `w`, in index order.
-    pub fn objects_of(&self, w: usize) -> impl Iterator<Item = u32> + '_ {
-        (0..self.place.len() as u32).filter(move |&o| self.worker(o) == w)
-    }
-
     /// Number of workers.
     pub fn workers(&self) -> usize {
         self.workers
@@ -588,11 +583,6 @@ impl<M: Model> Worker<M> {
             self.apply(op);
         }
         self.drain_local();
-    }
-
-    /// This worker's objects' current states, by object index.
-    pub fn states(&self) -> impl Iterator<Item = (u32, &M::State)> {
-        self.lps.iter().map(|lp| (lp.id, &lp.state))
     }
 
     /// Live messages waiting (not handled) on this worker.

@@ -328,11 +328,6 @@ where
         self.collector.pending as usize
     }
 
-    /// This process's MPI rank (0 without MPI): only rank 0 feeds the sink.
-    pub fn rank(&self) -> usize {
-        self.rank
-    }
-
     /// Every worker's memory samples (uncommitted batches plus held messages) per GVT round.
     pub fn memory_samples(&self) -> Vec<Vec<u64>> {
         self.workers.iter().map(|w| w.samples().to_vec()).collect()
