@@ -226,7 +226,6 @@ pub struct TimeWarp<M: Model> {
     workers: Vec<Worker<M>>,
     cfg: TwConfig,
     collector: Collector<M>,
-    rank: usize,
     ranks: usize,
 }
 
@@ -296,7 +295,6 @@ where
             workers,
             cfg,
             collector: Collector::new(states),
-            rank,
             ranks,
         }
     }
@@ -347,11 +345,12 @@ where
         } else {
             #[cfg(feature = "mpi")]
             {
+                let rank = place().0;
                 let fabric = super::mpi::MpiFabric::<M>::new(
-                    self.rank,
+                    rank,
                     self.ranks,
                     self.workers.len(),
-                    (self.rank == 0).then_some(tx),
+                    (rank == 0).then_some(tx),
                 );
                 self.drive(&fabric, &rx, until, sink, &mut failed);
                 // the last chunks of other ranks are still in parcels: one more exchange
