@@ -244,7 +244,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             workers: w,
             ..Default::default()
         });
-        phold.push(crate::model::phold::run(phold_cfg.clone(), 20.0, tw));
+        phold.push(crate::model::phold::run(phold_cfg.clone(), 20.0, tw)?);
     }
     if a.json {
         println!(

@@ -189,10 +189,10 @@ struct ReverseArgs {
     /// Quitting time Q.
     #[arg(long, allow_negative_numbers = true)]
     quit: f64,
-    /// event-list, time-step or objects.
+    /// event-list, time-step, objects or time-warp.
     #[arg(long, default_value = "event-list")]
     engine: String,
-    /// Sector layout of the objects engine: none, auto, N or NxM.
+    /// Sector layout of the objects engines: none, auto, N or NxM.
     #[arg(long)]
     sectors: Option<String>,
     #[command(flatten)]
@@ -367,7 +367,8 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
         },
         a.end,
         tw,
-    );
+    )
+    .map_err(internal)?;
     if poolsim::kernel::time_warp::threads::place().0 != 0 {
         return Ok(());
     }
@@ -824,10 +825,10 @@ struct RenderArgs {
     /// End time (default: the scenario's).
     #[arg(long, allow_negative_numbers = true)]
     until: Option<f64>,
-    /// event-list or objects.
+    /// event-list, objects or time-warp.
     #[arg(long, default_value = "event-list")]
     engine: String,
-    /// Sectors: none, auto, N or NxM; drawn on any engine, run by the objects engine.
+    /// Sectors: none, auto, N or NxM; drawn on any engine, run by the objects engines.
     #[arg(long)]
     sectors: Option<String>,
     #[command(flatten)]
@@ -885,7 +886,9 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
         quiet: true,
     };
     if a.engine == "time-step" {
-        return Err(usage("--engine: render draws with event-list or objects"));
+        return Err(usage(
+            "--engine: render draws with event-list, objects or time-warp",
+        ));
     }
     let engine = engine_of(&run_args, &scenario)?;
     if a.newvelocity_delay.is_some() && engine == EngineKind::EventList {

@@ -181,8 +181,9 @@ pub struct PholdReport {
 }
 
 /// Runs PHOLD up to time `end`, sequentially or (with `tw`) under Time Warp, one partition per
-/// worker when the partitions match the workers.
-pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> PholdReport {
+/// worker when the partitions match the workers. Fails only when Time Warp does (its memory
+/// budget).
+pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdReport, String> {
     let start = std::time::Instant::now();
     let (objects, events_per_object, remote, partitions) = (
         cfg.objects,
@@ -206,7 +207,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> PholdReport {
                 .collect();
             let mut ex = TimeWarp::new(model, states, t0, &worker_of, c);
             if let Err(TwError::Failed(m)) = ex.run(end, &mut { never }) {
-                panic!("PHOLD under Time Warp failed: {m}");
+                return Err(m);
             }
             (
                 ex.stats().clone(),
@@ -217,7 +218,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> PholdReport {
     };
     let wall = start.elapsed().as_secs_f64();
     let committed = stats.delivered;
-    PholdReport {
+    Ok(PholdReport {
         objects,
         events_per_object,
         remote,
@@ -237,7 +238,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> PholdReport {
                 .flat_map(|s| [s.handled, s.sends, s.rng.get_word_pos() as u64]),
         ),
         time_warp,
-    }
+    })
 }
 
 #[cfg(test)]
