@@ -124,7 +124,6 @@ pub struct Collector<M: Model> {
     states: Vec<M::State>,
     rounds: BTreeMap<u64, Vec<ChunkOf<M>>>,
     next_round: u64,
-    now: Option<VTime>,
     /// Statistics of the workers' last chunks.
     pub stats: TwStats,
     /// Committed message statistics (summed over runs).
@@ -140,7 +139,6 @@ impl<M: Model> Collector<M> {
             states,
             rounds: BTreeMap::new(),
             next_round: 1,
-            now: None,
             stats: TwStats::default(),
             messages: MessageStats::default(),
             pending: 0,
@@ -205,7 +203,6 @@ impl<M: Model> Collector<M> {
                         break;
                     }
                 }
-                self.now = Some(c.time);
                 if failed.is_some() {
                     break;
                 }
