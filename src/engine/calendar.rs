@@ -28,7 +28,29 @@ enum Place {
     Overflow,
 }
 
-/// The calendar queue. It stores ball indices; the keys live with the caller, who passes them in.
+/// A ball's links in its bucket's list and where its entry is: one record, so that queueing a
+/// ball touches one cache line of its own.
+#[derive(Clone, Copy, Debug)]
+struct Link {
+    next: u32,
+    prev: u32,
+    place: Place,
+}
+
+/// Where the calendar reads each ball's key: the keys live with the caller, who passes them in.
+pub trait Keys {
+    /// Ball `i`'s queued key (an infinite time: not queued).
+    fn key(&self, i: u32) -> &Key;
+}
+
+impl Keys for [Key] {
+    #[inline]
+    fn key(&self, i: u32) -> &Key {
+        &self[i as usize]
+    }
+}
+
+/// The calendar queue. It stores ball indices and reads their keys through [`Keys`].
 #[derive(Clone, Debug)]
 pub struct Calendar {
     inv_width: f64,
@@ -37,9 +59,7 @@ pub struct Calendar {
     head: Vec<u32>,
     overflow: u32,
     in_ring: usize,
-    next: Vec<u32>,
-    prev: Vec<u32>,
-    place: Vec<Place>,
+    links: Vec<Link>,
     heap: Vec<u32>,
 }
 
@@ -61,9 +81,14 @@ impl Calendar {
             head: vec![NIL; buckets],
             overflow: NIL,
             in_ring: 0,
-            next: vec![NIL; n],
-            prev: vec![NIL; n],
-            place: vec![Place::Nowhere; n],
+            links: vec![
+                Link {
+                    next: NIL,
+                    prev: NIL,
+                    place: Place::Nowhere,
+                };
+                n
+            ],
             heap: Vec::new(),
         }
     }
@@ -80,13 +105,13 @@ impl Calendar {
 
     /// Sets ball `i`'s event to `key` (replacing any earlier one). `keys[i]` must already be `key`.
     #[inline]
-    pub fn set(&mut self, keys: &[Key], i: u32) {
+    pub fn set<K: Keys + ?Sized>(&mut self, keys: &K, i: u32) {
         self.remove(keys, i);
         self.insert(keys, i);
     }
 
-    fn insert(&mut self, keys: &[Key], i: u32) {
-        let t = keys[i as usize].t;
+    fn insert<K: Keys + ?Sized>(&mut self, keys: &K, i: u32) {
+        let t = keys.key(i).t;
         if !t.is_finite() {
             return;
         }
@@ -98,60 +123,60 @@ impl Calendar {
             let h = self.head[slot as usize];
             self.link(i, h);
             self.head[slot as usize] = i;
-            self.place[i as usize] = Place::Ring(slot);
+            self.links[i as usize].place = Place::Ring(slot);
             self.in_ring += 1;
         } else {
             let h = self.overflow;
             self.link(i, h);
             self.overflow = i;
-            self.place[i as usize] = Place::Overflow;
+            self.links[i as usize].place = Place::Overflow;
         }
     }
 
     #[inline]
     fn link(&mut self, i: u32, h: u32) {
-        self.next[i as usize] = h;
-        self.prev[i as usize] = NIL;
+        self.links[i as usize].next = h;
+        self.links[i as usize].prev = NIL;
         if h != NIL {
-            self.prev[h as usize] = i;
+            self.links[h as usize].prev = i;
         }
     }
 
     fn unlink(&mut self, i: u32) -> bool {
-        let (p, n) = (self.prev[i as usize], self.next[i as usize]);
+        let (p, n) = (self.links[i as usize].prev, self.links[i as usize].next);
         if n != NIL {
-            self.prev[n as usize] = p;
+            self.links[n as usize].prev = p;
         }
         if p != NIL {
-            self.next[p as usize] = n;
+            self.links[p as usize].next = n;
             false
         } else {
             true // i was the head
         }
     }
 
-    fn remove(&mut self, keys: &[Key], i: u32) {
-        match self.place[i as usize] {
+    fn remove<K: Keys + ?Sized>(&mut self, keys: &K, i: u32) {
+        match self.links[i as usize].place {
             Place::Nowhere => {}
             Place::Heap(k) => self.heap_remove(keys, k as usize),
             Place::Ring(slot) => {
                 if self.unlink(i) {
-                    self.head[slot as usize] = self.next[i as usize];
+                    self.head[slot as usize] = self.links[i as usize].next;
                 }
                 self.in_ring -= 1;
             }
             Place::Overflow => {
                 if self.unlink(i) {
-                    self.overflow = self.next[i as usize];
+                    self.overflow = self.links[i as usize].next;
                 }
             }
         }
-        self.place[i as usize] = Place::Nowhere;
+        self.links[i as usize].place = Place::Nowhere;
     }
 
     /// The ball with the earliest event, or `None` if no ball has one.
     #[inline]
-    pub fn first(&mut self, keys: &[Key]) -> Option<u32> {
+    pub fn first<K: Keys + ?Sized>(&mut self, keys: &K) -> Option<u32> {
         while self.heap.is_empty() {
             if !self.advance(keys) {
                 return None;
@@ -161,14 +186,14 @@ impl Calendar {
     }
 
     /// Moves to the next bucket with entries; false when the calendar is empty.
-    fn advance(&mut self, keys: &[Key]) -> bool {
+    fn advance<K: Keys + ?Sized>(&mut self, keys: &K) -> bool {
         if self.in_ring == 0 {
             // jump straight to the earliest overflow entry
             let mut j = self.overflow;
             let mut earliest = i64::MAX;
             while j != NIL {
-                earliest = earliest.min(self.bucket(keys[j as usize].t));
-                j = self.next[j as usize];
+                earliest = earliest.min(self.bucket(keys.key(j).t));
+                j = self.links[j as usize].next;
             }
             if earliest == i64::MAX {
                 return false;
@@ -183,9 +208,9 @@ impl Calendar {
         let mut j = self.head[slot];
         self.head[slot] = NIL;
         while j != NIL {
-            let n = self.next[j as usize];
+            let n = self.links[j as usize].next;
             self.in_ring -= 1;
-            self.place[j as usize] = Place::Nowhere;
+            self.links[j as usize].place = Place::Nowhere;
             self.heap_push(keys, j);
             j = n;
         }
@@ -193,11 +218,11 @@ impl Calendar {
     }
 
     /// Moves overflow entries that now fall inside the ring's window into it.
-    fn pull_overflow(&mut self, keys: &[Key]) {
+    fn pull_overflow<K: Keys + ?Sized>(&mut self, keys: &K) {
         let mut j = self.overflow;
         while j != NIL {
-            let n = self.next[j as usize];
-            if self.bucket(keys[j as usize].t) - self.base < self.ring_len() {
+            let n = self.links[j as usize].next;
+            if self.bucket(keys.key(j).t) - self.base < self.ring_len() {
                 self.remove(keys, j);
                 self.insert(keys, j);
             }
@@ -206,8 +231,8 @@ impl Calendar {
     }
 
     #[inline]
-    fn less(keys: &[Key], a: u32, b: u32) -> bool {
-        let (ka, kb) = (&keys[a as usize], &keys[b as usize]);
+    fn less<K: Keys + ?Sized>(keys: &K, a: u32, b: u32) -> bool {
+        let (ka, kb) = (keys.key(a), keys.key(b));
         match ka.t.total_cmp(&kb.t) {
             Ordering::Less => true,
             Ordering::Greater => false,
@@ -215,24 +240,24 @@ impl Calendar {
         }
     }
 
-    fn heap_push(&mut self, keys: &[Key], i: u32) {
+    fn heap_push<K: Keys + ?Sized>(&mut self, keys: &K, i: u32) {
         self.heap.push(i);
         let k = self.heap.len() - 1;
-        self.place[i as usize] = Place::Heap(k as u32);
+        self.links[i as usize].place = Place::Heap(k as u32);
         self.sift_up(keys, k);
     }
 
-    fn heap_remove(&mut self, keys: &[Key], k: usize) {
+    fn heap_remove<K: Keys + ?Sized>(&mut self, keys: &K, k: usize) {
         let last = self.heap.pop().expect("the entry is in the heap");
         if k < self.heap.len() {
             self.heap[k] = last;
-            self.place[last as usize] = Place::Heap(k as u32);
+            self.links[last as usize].place = Place::Heap(k as u32);
             let k = self.sift_up(keys, k);
             self.sift_down(keys, k);
         }
     }
 
-    fn sift_up(&mut self, keys: &[Key], mut k: usize) -> usize {
+    fn sift_up<K: Keys + ?Sized>(&mut self, keys: &K, mut k: usize) -> usize {
         while k > 0 {
             let p = (k - 1) / 2;
             if Self::less(keys, self.heap[k], self.heap[p]) {
@@ -245,7 +270,7 @@ impl Calendar {
         k
     }
 
-    fn sift_down(&mut self, keys: &[Key], mut k: usize) {
+    fn sift_down<K: Keys + ?Sized>(&mut self, keys: &K, mut k: usize) {
         loop {
             let (l, r) = (2 * k + 1, 2 * k + 2);
             let mut m = k;
@@ -266,14 +291,14 @@ impl Calendar {
     #[inline]
     fn swap(&mut self, a: usize, b: usize) {
         self.heap.swap(a, b);
-        self.place[self.heap[a] as usize] = Place::Heap(a as u32);
-        self.place[self.heap[b] as usize] = Place::Heap(b as u32);
+        self.links[self.heap[a] as usize].place = Place::Heap(a as u32);
+        self.links[self.heap[b] as usize].place = Place::Heap(b as u32);
     }
 
     /// Bytes of memory held.
     pub fn memory_bytes(&self) -> usize {
-        4 * (self.head.len() + self.next.len() + self.prev.len() + self.heap.capacity())
-            + std::mem::size_of::<Place>() * self.place.len()
+        4 * (self.head.len() + self.heap.capacity())
+            + std::mem::size_of::<Link>() * self.links.len()
     }
 }
 
@@ -300,7 +325,7 @@ mod tests {
                     let want = (0..n as u32)
                         .filter(|&b| keys[b as usize].t.is_finite())
                         .min_by(|&a, &b| keys[a as usize].cmp(&keys[b as usize]));
-                    let got = cal.first(&keys);
+                    let got = cal.first(&keys[..]);
                     prop_assert_eq!(
                         got.map(|g| keys[g as usize].clone()),
                         want.map(|w| keys[w as usize].clone())
@@ -308,13 +333,13 @@ mod tests {
                     if let Some(g) = got {
                         now = keys[g as usize].t;
                         keys[g as usize] = Key::at(f64::INFINITY, 0);
-                        cal.set(&keys, g);
+                        cal.set(&keys[..], g);
                     }
                 } else {
                     // times never go before the last popped one, as in a simulation
                     let t = if tie == 0 { now } else { now + (dt * tie as f64).round() / 4.0 };
                     keys[i as usize] = Key::at(t, pair(i, 100 + tie));
-                    cal.set(&keys, i);
+                    cal.set(&keys[..], i);
                 }
             }
         }

@@ -16,8 +16,9 @@
 //! event no later than `X`; if that event is popped stale, the ball recomputes and keeps one no
 //! later than `X` again. So the earliest valid event is never missed.
 
-use super::calendar::Calendar;
+use super::calendar::{Calendar, Keys};
 use super::grid::Grid;
+use super::prefetch::prefetch;
 use super::{
     BallState, Event, EventCounts, EventKind, Fixed, Frame, Observer, Outcome, RunError, Span,
     Table, World,
@@ -26,6 +27,7 @@ use crate::geometry::Trajectory;
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
+use smallvec::SmallVec;
 use std::cmp::Ordering;
 
 /// The pair code that marks a ball leaving its cell: sorts after every physical event of its
@@ -82,6 +84,30 @@ struct Slot {
 
 const NOT_ON_TABLE: u32 = u32::MAX;
 
+/// The rest of a ball's state, read only when the ball itself is handled (never by a neighbour's
+/// prediction): two cache lines, so handling a ball costs few trips to memory.
+#[derive(Clone, Debug)]
+#[repr(align(64))]
+struct Own {
+    /// Its earliest physical event.
+    phys: Best,
+    /// Its queued key: the earlier of its physical event and its cell crossing.
+    queued: Key,
+    /// The key at which its trajectory was fixed.
+    fixed_at: Key,
+    /// Mass.
+    mass: f64,
+    /// The cell its centre enters at the slot's `cross_t`.
+    cross_cell: u32,
+}
+
+impl Keys for [Own] {
+    #[inline]
+    fn key(&self, i: u32) -> &Key {
+        &self[i as usize].queued
+    }
+}
+
 /// Counters an event-list run reports beside its events.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Stats {
@@ -99,16 +125,8 @@ pub struct Stats {
 pub struct EventList {
     table: Table,
     slots: Vec<Slot>,
-    mass: Vec<f64>,
+    own: Vec<Own>,
     pocket: Vec<Option<u32>>,
-    /// The key at which each ball's trajectory was fixed.
-    fixed_at: Vec<Key>,
-    /// Each ball's earliest physical event.
-    phys: Vec<Best>,
-    /// The cell each ball's centre enters at `cross_t`.
-    cross_cell: Vec<u32>,
-    /// Each ball's queued key: the earlier of its physical event and its cell crossing.
-    keys: Vec<Key>,
     queue: Calendar,
     grid: Grid,
     now: f64,
@@ -166,12 +184,17 @@ impl EventList {
         let mut e = EventList {
             table,
             slots,
-            mass: balls.iter().map(|b| b.mass).collect(),
+            own: balls
+                .iter()
+                .map(|b| Own {
+                    phys: Best::none(),
+                    queued: Key::at(f64::INFINITY, 0),
+                    fixed_at: Key::start(start),
+                    mass: b.mass,
+                    cross_cell: 0,
+                })
+                .collect(),
             pocket: vec![None; n],
-            fixed_at: vec![Key::start(start); n],
-            phys: vec![Best::none(); n],
-            cross_cell: vec![0; n],
-            keys: vec![Key::at(f64::INFINITY, 0); n],
             queue: Calendar::new(n, start, 1.0),
             grid,
             now: start,
@@ -186,15 +209,15 @@ impl EventList {
             e.predict(i);
         }
         let finite: Vec<f64> = e
-            .keys
+            .own
             .iter()
-            .map(|k| k.t)
+            .map(|o| o.queued.t)
             .filter(|t| t.is_finite())
             .collect();
         let mean = finite.iter().map(|t| t - start).sum::<f64>() / finite.len().max(1) as f64;
         e.queue = Calendar::new(n, start, mean / finite.len().max(1) as f64);
         for i in 0..n as u32 {
-            e.queue.set(&e.keys, i);
+            e.queue.set(&e.own[..], i);
         }
         e
     }
@@ -213,7 +236,7 @@ impl EventList {
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
         let n = self.slots.len();
-        n * (size_of::<Slot>() + 8 + 8 + 2 * size_of::<Key>() + size_of::<Best>() + 4)
+        n * (size_of::<Slot>() + size_of::<Own>() + size_of::<Option<u32>>())
             + self.queue.memory_bytes()
             + self.grid.memory_bytes()
     }
@@ -237,7 +260,10 @@ impl EventList {
                 }
             }
             Contact::Immediate => {
-                let (fi, fj) = (&self.fixed_at[i as usize], &self.fixed_at[j as usize]);
+                let (fi, fj) = (
+                    &self.own[i as usize].fixed_at,
+                    &self.own[j as usize].fixed_at,
+                );
                 let key = fi.max(fj).child(p);
                 if key < best.key {
                     best.key = key;
@@ -261,7 +287,7 @@ impl EventList {
                     }
                 }
                 Contact::Immediate => {
-                    let key = self.fixed_at[i as usize].child(p);
+                    let key = self.own[i as usize].fixed_at.child(p);
                     if key < best.key {
                         best.key = key;
                         best.partner = Partner::Fixed(f);
@@ -277,17 +303,22 @@ impl EventList {
         let b = self.slots[i as usize];
         let mut best = Best::none();
         if b.cell != NOT_ON_TABLE {
-            let mut tests = 0u64;
+            // Gather the neighbours first and ask for all their records at once, so their
+            // trips to memory overlap instead of following one another.
+            let mut near = SmallVec::<[u32; 48]>::new();
             self.grid.for_each_near(b.cell, |j| {
                 if j != i {
-                    tests += 1;
-                    self.offer_ball(i, &b, j, &mut best);
+                    prefetch(&self.slots[j as usize]);
+                    near.push(j);
                 }
             });
-            tests += self.offer_fixed(i, &b, b.cell, &mut best);
+            for &j in &near {
+                self.offer_ball(i, &b, j, &mut best);
+            }
+            let tests = near.len() as u64 + self.offer_fixed(i, &b, b.cell, &mut best);
             self.stats.predictions += tests;
         }
-        self.phys[i as usize] = best;
+        self.own[i as usize].phys = best;
         self.set_exit(i);
         self.requeue(i);
     }
@@ -300,7 +331,7 @@ impl EventList {
         self.grid.insert(i, to);
         self.slots[i as usize].cell = to;
         let b = self.slots[i as usize];
-        let mut best = std::mem::replace(&mut self.phys[i as usize], Best::none());
+        let mut best = std::mem::replace(&mut self.own[i as usize].phys, Best::none());
         let mut tests = 0u64;
         self.grid.for_each_entering(from, to, |j| {
             tests += 1;
@@ -308,7 +339,7 @@ impl EventList {
         });
         tests += self.offer_fixed(i, &b, to, &mut best);
         self.stats.predictions += tests;
-        self.phys[i as usize] = best;
+        self.own[i as usize].phys = best;
         self.set_exit(i);
         self.requeue(i);
     }
@@ -325,7 +356,7 @@ impl EventList {
         match exit {
             Some((t, c)) => {
                 b.cross_t = t.max(self.now);
-                self.cross_cell[i as usize] = c;
+                self.own[i as usize].cross_cell = c;
             }
             None => b.cross_t = f64::INFINITY,
         }
@@ -334,13 +365,13 @@ impl EventList {
     /// Queues ball `i` at the earlier of its physical event and its cell crossing.
     fn requeue(&mut self, i: u32) {
         let t = self.slots[i as usize].cross_t;
-        let phys = &self.phys[i as usize].key;
-        self.keys[i as usize] = if phys.cmp_at(t, CELL_CROSSING) == Ordering::Greater {
+        let phys = &self.own[i as usize].phys.key;
+        self.own[i as usize].queued = if phys.cmp_at(t, CELL_CROSSING) == Ordering::Greater {
             Key::at(t, CELL_CROSSING)
         } else {
             phys.clone()
         };
-        self.queue.set(&self.keys, i);
+        self.queue.set(&self.own[..], i);
     }
 
     fn set_velocity(&mut self, i: u32, key: &Key, velocity: crate::geometry::Vec2) {
@@ -351,7 +382,7 @@ impl EventList {
             t0: key.t,
         };
         b.counter = b.counter.wrapping_add(1);
-        self.fixed_at[i as usize] = key.clone();
+        self.own[i as usize].fixed_at = key.clone();
     }
 
     /// Runs until the next event would come after `until`, reporting each event to `obs`, and
@@ -376,9 +407,9 @@ impl EventList {
                 until = self.now;
                 break;
             }
-            let first = self.queue.first(&self.keys);
+            let first = self.queue.first(&self.own[..]);
             if let Some(r) = &self.reversal {
-                let before = first.is_none_or(|i| *r < self.keys[i as usize]);
+                let before = first.is_none_or(|i| *r < self.own[i as usize].queued);
                 if before && r.t <= until {
                     let r = self.reversal.take().expect("checked above");
                     self.reverse(&r);
@@ -387,7 +418,7 @@ impl EventList {
             }
             if let Some(f) = self.span.frame(self.frames) {
                 let frame = Key::at(f, DISPLAY);
-                let before = first.is_none_or(|i| frame < self.keys[i as usize])
+                let before = first.is_none_or(|i| frame < self.own[i as usize].queued)
                     && self.reversal.as_ref().is_none_or(|r| frame < *r);
                 if before && f <= until {
                     self.frames += 1;
@@ -402,17 +433,17 @@ impl EventList {
             let Some(i) = first else {
                 break;
             };
-            let key = self.keys[i as usize].clone();
+            let key = self.own[i as usize].queued.clone();
             if key.t > until {
                 break;
             }
             self.now = key.t;
             if key.path[..] == [CELL_CROSSING] {
                 self.stats.cell_crossings += 1;
-                self.cross(i, self.cross_cell[i as usize]);
+                self.cross(i, self.own[i as usize].cross_cell);
                 continue;
             }
-            match self.phys[i as usize].partner {
+            match self.own[i as usize].phys.partner {
                 Partner::Nothing => break,
                 Partner::Return(f) => {
                     let b = &mut self.slots[i as usize];
@@ -421,7 +452,7 @@ impl EventList {
                     b.counter = b.counter.wrapping_add(1);
                     self.grid.insert(i, cell);
                     self.pocket[i as usize] = None;
-                    self.fixed_at[i as usize] = key.clone();
+                    self.own[i as usize].fixed_at = key.clone();
                     self.predict(i);
                     self.emit(&key, EventKind::BallPocket, i, f, &mut counts, obs)?;
                 }
@@ -433,13 +464,16 @@ impl EventList {
                 Partner::Ball(j, _) => {
                     let (a, b) = (i.min(j), i.max(j));
                     let (sa, sb) = (self.slots[a as usize], self.slots[b as usize]);
+                    prefetch(&self.own[j as usize]);
+                    self.grid.prefetch_near(sa.cell);
+                    self.grid.prefetch_near(sb.cell);
                     let (va, vb) = physics::ball_ball_velocities(
                         sa.traj.at(key.t),
                         sa.traj.velocity,
-                        self.mass[a as usize],
+                        self.own[a as usize].mass,
                         sb.traj.at(key.t),
                         sb.traj.velocity,
-                        self.mass[b as usize],
+                        self.own[b as usize].mass,
                     );
                     self.set_velocity(a, &key, va);
                     self.set_velocity(b, &key, vb);
@@ -510,7 +544,7 @@ impl EventList {
                         t0: r.t,
                     };
                     b.counter = b.counter.wrapping_add(1);
-                    self.fixed_at[i as usize] = r.clone();
+                    self.own[i as usize].fixed_at = r.clone();
                 }
                 Some(k) => {
                     let back = 2.0 * r.t - b.traj.t0;
@@ -520,7 +554,7 @@ impl EventList {
                         t0: back,
                     };
                     let f = self.table.fixed_id(Fixed::Pocket(k));
-                    self.phys[i as usize] = Best {
+                    self.own[i as usize].phys = Best {
                         key: crate::model::pool::return_key(r, back, pair(i, f)),
                         partner: Partner::Return(f),
                     };
@@ -589,7 +623,7 @@ impl World for EventList {
         BallState {
             traj: s.traj,
             radius: s.radius,
-            mass: self.mass[i as usize],
+            mass: self.own[i as usize].mass,
             pocket: self.pocket[i as usize],
         }
     }

@@ -9,6 +9,7 @@
 //! another); when a cell fills up, every cell gets twice the slots. Fixed objects are listed once
 //! per cell they may reach, in compressed rows.
 
+use super::prefetch::prefetch;
 use super::Table;
 use crate::geometry::Vec2;
 
@@ -28,11 +29,14 @@ pub struct Grid {
     nx: u32,
     ny: u32,
     cap: usize,
+    /// `cap` ball indices per cell, the balls first and `NIL` after them.
     slots: Vec<u32>,
-    len: Vec<u8>,
     cell_of: Vec<u32>,
     fixed_start: Vec<u32>,
     fixed_items: Vec<u32>,
+    /// One bit per cell: set where some fixed object is near. Small enough to stay in cache, so
+    /// the many cells with none cost no trip to memory.
+    has_fixed: Vec<u64>,
 }
 
 impl Grid {
@@ -58,10 +62,10 @@ impl Grid {
             ny,
             cap: 4,
             slots: vec![NIL; 4 * (nx * ny) as usize],
-            len: vec![0; (nx * ny) as usize],
             cell_of: vec![NIL; n],
             fixed_start: Vec::new(),
             fixed_items: Vec::new(),
+            has_fixed: vec![0; (nx * ny).div_ceil(64) as usize],
         };
         if g.width.is_nan() || g.width <= 0.0 || g.height.is_nan() || g.height <= 0.0 {
             g.width = w_min;
@@ -81,6 +85,7 @@ impl Grid {
             for &id in &ids {
                 if table.distance2_to_rect(id, lo, hi) <= reach2 {
                     self.fixed_items.push(id);
+                    self.has_fixed[c as usize / 64] |= 1 << (c % 64);
                 }
             }
             self.fixed_start.push(self.fixed_items.len() as u32);
@@ -139,12 +144,11 @@ impl Grid {
     #[inline]
     pub fn insert(&mut self, i: u32, c: u32) {
         let c = c as usize;
-        if usize::from(self.len[c]) == self.cap {
+        if self.count(c) == self.cap {
             self.grow();
         }
-        let k = usize::from(self.len[c]);
+        let k = self.count(c);
         self.slots[c * self.cap + k] = i;
-        self.len[c] += 1;
         self.cell_of[i as usize] = c as u32;
     }
 
@@ -152,11 +156,11 @@ impl Grid {
     fn grow(&mut self) {
         let cap = 2 * self.cap;
         assert!(cap <= 128, "more than 128 ball centres in one grid cell");
-        let mut slots = vec![NIL; cap * self.len.len()];
-        for (c, &n) in self.len.iter().enumerate() {
-            let n = usize::from(n);
-            slots[c * cap..c * cap + n]
-                .copy_from_slice(&self.slots[c * self.cap..c * self.cap + n]);
+        let cells = self.slots.len() / self.cap;
+        let mut slots = vec![NIL; cap * cells];
+        for c in 0..cells {
+            slots[c * cap..c * cap + self.cap]
+                .copy_from_slice(&self.slots[c * self.cap..(c + 1) * self.cap]);
         }
         self.slots = slots;
         self.cap = cap;
@@ -170,7 +174,7 @@ impl Grid {
             return;
         }
         let c = c as usize;
-        let n = usize::from(self.len[c]);
+        let n = self.count(c);
         let cell = &mut self.slots[c * self.cap..c * self.cap + n];
         let k = cell
             .iter()
@@ -178,8 +182,30 @@ impl Grid {
             .expect("a ball is in the cell it was put in");
         cell[k] = cell[n - 1];
         cell[n - 1] = NIL;
-        self.len[c] -= 1;
         self.cell_of[i as usize] = NIL;
+    }
+
+    /// How many balls cell `c` holds.
+    #[inline]
+    fn count(&self, c: usize) -> usize {
+        let cell = &self.slots[c * self.cap..(c + 1) * self.cap];
+        cell.iter().position(|&j| j == NIL).unwrap_or(self.cap)
+    }
+
+    /// Starts loading the 3 × 3 block of cells around cell `c` (if it is a cell) into cache.
+    #[inline]
+    pub fn prefetch_near(&self, c: u32) {
+        if c >= self.nx * self.ny {
+            return;
+        }
+        let (cx, cy) = (c % self.nx, c / self.nx);
+        let x0 = cx.saturating_sub(1) as usize;
+        let x1 = (cx + 1).min(self.nx - 1) as usize;
+        for y in cy.saturating_sub(1)..=(cy + 1).min(self.ny - 1) {
+            let row = (y * self.nx) as usize;
+            prefetch(&self.slots[(row + x0) * self.cap]);
+            prefetch(&self.slots[(row + x1 + 1) * self.cap - 1]);
+        }
     }
 
     /// Calls `f` with every ball in the 3 × 3 block of cells around cell `c` (including any ball
@@ -193,9 +219,9 @@ impl Grid {
         let y1 = (cy + 1).min(self.ny - 1);
         for y in y0..=y1 {
             let row = (y * self.nx) as usize;
-            for c in row + x0 as usize..=row + x1 as usize {
-                let n = usize::from(self.len[c]);
-                for &j in &self.slots[c * self.cap..c * self.cap + n] {
+            let run = (row + x0 as usize) * self.cap..(row + x1 as usize + 1) * self.cap;
+            for &j in &self.slots[run] {
+                if j != NIL {
                     f(j);
                 }
             }
@@ -214,9 +240,10 @@ impl Grid {
                     continue;
                 }
                 let c = (y * self.nx + x) as usize;
-                let n = usize::from(self.len[c]);
-                for &j in &self.slots[c * self.cap..c * self.cap + n] {
-                    f(j);
+                for &j in &self.slots[c * self.cap..(c + 1) * self.cap] {
+                    if j != NIL {
+                        f(j);
+                    }
                 }
             }
         }
@@ -225,6 +252,9 @@ impl Grid {
     /// The fixed objects a ball whose centre is in cell `c` may touch before it leaves the cell.
     #[inline]
     pub fn fixed_near(&self, c: u32) -> &[u32] {
+        if self.has_fixed[c as usize / 64] & (1 << (c % 64)) == 0 {
+            return &[];
+        }
         let (a, b) = (
             self.fixed_start[c as usize] as usize,
             self.fixed_start[c as usize + 1] as usize,
@@ -266,6 +296,6 @@ impl Grid {
             + self.cell_of.len()
             + self.fixed_start.len()
             + self.fixed_items.len())
-            + self.len.len()
+            + 8 * self.has_fixed.len()
     }
 }
