@@ -6,6 +6,11 @@
 //! however many balls there are (the O(1) queue of G. Paul, J. Comput. Phys. 221, 2007). A
 //! tournament tree over a million balls costs some twenty cache misses per update instead.
 //!
+//! Buckets are singly linked lists of small nodes, and an entry is removed lazily: moving a ball's
+//! event only forgets the node it had (the ball's [`Place`] no longer names it), and the dead node
+//! is dropped when its bucket comes up. So queueing a ball touches its own record, the bucket's
+//! head and a recycled node, and never another ball's record.
+//!
 //! The order is exactly the virtual-time order: a bucket holds events by time only, and the heap
 //! orders the current bucket by full [`Key`], so ties within an instant come out as DESIGN.md
 //! says whatever the bucket width.
@@ -15,42 +20,59 @@ use std::cmp::Ordering;
 
 const NIL: u32 = u32::MAX;
 
-/// Where a ball's entry is.
+/// Where a ball's entry is, packed in one word the caller keeps with the ball: not queued, in
+/// the current bucket's heap at an index, or in a ring bucket or the overflow list at a node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Place {
+pub struct Place(u32);
+
+const TAG: u32 = 3 << 30;
+const HEAP: u32 = 1 << 30;
+const RING: u32 = 2 << 30;
+const OVERFLOW: u32 = 3 << 30;
+
+impl Place {
     /// Not queued (no event, or an infinite time).
-    Nowhere,
-    /// In the current bucket's heap, at this index.
-    Heap(u32),
-    /// In the ring's bucket with this slot.
-    Ring(u32),
-    /// In the overflow list.
-    Overflow,
-}
+    pub const NOWHERE: Place = Place(0);
 
-/// A ball's links in its bucket's list and where its entry is: one record, so that queueing a
-/// ball touches one cache line of its own.
-#[derive(Clone, Copy, Debug)]
-struct Link {
-    next: u32,
-    prev: u32,
-    place: Place,
-}
+    fn heap(k: usize) -> Place {
+        Place(HEAP | k as u32)
+    }
 
-/// Where the calendar reads each ball's key: the keys live with the caller, who passes them in.
-pub trait Keys {
-    /// Ball `i`'s queued key (an infinite time: not queued).
-    fn key(&self, i: u32) -> &Key;
-}
+    fn ring(node: u32) -> Place {
+        Place(RING | node)
+    }
 
-impl Keys for [Key] {
-    #[inline]
-    fn key(&self, i: u32) -> &Key {
-        &self[i as usize]
+    fn overflow(node: u32) -> Place {
+        Place(OVERFLOW | node)
+    }
+
+    fn tag(self) -> u32 {
+        self.0 & TAG
+    }
+
+    fn index(self) -> u32 {
+        self.0 & !TAG
     }
 }
 
-/// The calendar queue. It stores ball indices and reads their keys through [`Keys`].
+/// What the calendar reads and writes in the caller's per-ball records.
+pub trait Entries {
+    /// Ball `i`'s queued key (an infinite time: not queued).
+    fn key(&self, i: u32) -> &Key;
+    /// Where ball `i`'s entry is.
+    fn place(&self, i: u32) -> Place;
+    /// Records where ball `i`'s entry is.
+    fn set_place(&mut self, i: u32, place: Place);
+}
+
+/// A bucket list node: a ball and the next node.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    ball: u32,
+    next: u32,
+}
+
+/// The calendar queue. It stores ball indices and reaches their keys through [`Entries`].
 #[derive(Clone, Debug)]
 pub struct Calendar {
     inv_width: f64,
@@ -58,8 +80,11 @@ pub struct Calendar {
     base: i64,
     head: Vec<u32>,
     overflow: u32,
+    /// Live entries in the ring.
     in_ring: usize,
-    links: Vec<Link>,
+    nodes: Vec<Node>,
+    /// The first recycled node (linked through `next`).
+    free: u32,
     heap: Vec<u32>,
 }
 
@@ -81,14 +106,8 @@ impl Calendar {
             head: vec![NIL; buckets],
             overflow: NIL,
             in_ring: 0,
-            links: vec![
-                Link {
-                    next: NIL,
-                    prev: NIL,
-                    place: Place::Nowhere,
-                };
-                n
-            ],
+            nodes: Vec::with_capacity(n),
+            free: NIL,
             heap: Vec::new(),
         }
     }
@@ -103,82 +122,73 @@ impl Calendar {
         self.mask as i64 + 1
     }
 
-    /// Sets ball `i`'s event to `key` (replacing any earlier one). `keys[i]` must already be `key`.
+    /// Sets ball `i`'s event to its current key (replacing any earlier one).
     #[inline]
-    pub fn set<K: Keys + ?Sized>(&mut self, keys: &K, i: u32) {
-        self.remove(keys, i);
-        self.insert(keys, i);
+    pub fn set<E: Entries + ?Sized>(&mut self, e: &mut E, i: u32) {
+        self.remove(e, i);
+        self.insert(e, i);
     }
 
-    fn insert<K: Keys + ?Sized>(&mut self, keys: &K, i: u32) {
-        let t = keys.key(i).t;
+    fn insert<E: Entries + ?Sized>(&mut self, e: &mut E, i: u32) {
+        let t = e.key(i).t;
         if !t.is_finite() {
             return;
         }
         let b = self.bucket(t);
         if b <= self.base {
-            self.heap_push(keys, i);
+            self.heap_push(e, i);
         } else if b - self.base < self.ring_len() {
-            let slot = (b as u64 & self.mask) as u32;
-            let h = self.head[slot as usize];
-            self.link(i, h);
-            self.head[slot as usize] = i;
-            self.links[i as usize].place = Place::Ring(slot);
+            let slot = (b as u64 & self.mask) as usize;
+            let node = self.node(i, self.head[slot]);
+            self.head[slot] = node;
+            e.set_place(i, Place::ring(node));
             self.in_ring += 1;
         } else {
-            let h = self.overflow;
-            self.link(i, h);
-            self.overflow = i;
-            self.links[i as usize].place = Place::Overflow;
+            let node = self.node(i, self.overflow);
+            self.overflow = node;
+            e.set_place(i, Place::overflow(node));
+        }
+    }
+
+    /// A node for ball `i` in front of `next`, recycled where one is free.
+    #[inline]
+    fn node(&mut self, ball: u32, next: u32) -> u32 {
+        let node = Node { ball, next };
+        if self.free == NIL {
+            self.nodes.push(node);
+            let k = self.nodes.len() as u32 - 1;
+            assert!(k < HEAP, "calendar nodes exhausted");
+            k
+        } else {
+            let k = self.free;
+            self.free = self.nodes[k as usize].next;
+            self.nodes[k as usize] = node;
+            k
         }
     }
 
     #[inline]
-    fn link(&mut self, i: u32, h: u32) {
-        self.links[i as usize].next = h;
-        self.links[i as usize].prev = NIL;
-        if h != NIL {
-            self.links[h as usize].prev = i;
-        }
+    fn recycle(&mut self, node: u32) {
+        self.nodes[node as usize].next = self.free;
+        self.free = node;
     }
 
-    fn unlink(&mut self, i: u32) -> bool {
-        let (p, n) = (self.links[i as usize].prev, self.links[i as usize].next);
-        if n != NIL {
-            self.links[n as usize].prev = p;
+    /// Takes ball `i`'s entry out: at once from the heap, lazily from a list.
+    fn remove<E: Entries + ?Sized>(&mut self, e: &mut E, i: u32) {
+        let p = e.place(i);
+        match p.tag() {
+            HEAP => self.heap_remove(e, p.index() as usize),
+            RING => self.in_ring -= 1,
+            _ => {}
         }
-        if p != NIL {
-            self.links[p as usize].next = n;
-            false
-        } else {
-            true // i was the head
-        }
-    }
-
-    fn remove<K: Keys + ?Sized>(&mut self, keys: &K, i: u32) {
-        match self.links[i as usize].place {
-            Place::Nowhere => {}
-            Place::Heap(k) => self.heap_remove(keys, k as usize),
-            Place::Ring(slot) => {
-                if self.unlink(i) {
-                    self.head[slot as usize] = self.links[i as usize].next;
-                }
-                self.in_ring -= 1;
-            }
-            Place::Overflow => {
-                if self.unlink(i) {
-                    self.overflow = self.links[i as usize].next;
-                }
-            }
-        }
-        self.links[i as usize].place = Place::Nowhere;
+        e.set_place(i, Place::NOWHERE);
     }
 
     /// The ball with the earliest event, or `None` if no ball has one.
     #[inline]
-    pub fn first<K: Keys + ?Sized>(&mut self, keys: &K) -> Option<u32> {
+    pub fn first<E: Entries + ?Sized>(&mut self, e: &mut E) -> Option<u32> {
         while self.heap.is_empty() {
-            if !self.advance(keys) {
+            if !self.advance(e) {
                 return None;
             }
         }
@@ -186,53 +196,77 @@ impl Calendar {
     }
 
     /// Moves to the next bucket with entries; false when the calendar is empty.
-    fn advance<K: Keys + ?Sized>(&mut self, keys: &K) -> bool {
+    fn advance<E: Entries + ?Sized>(&mut self, e: &mut E) -> bool {
         if self.in_ring == 0 {
-            // jump straight to the earliest overflow entry
-            let mut j = self.overflow;
+            // jump straight to the earliest live overflow entry
+            let mut k = self.overflow;
             let mut earliest = i64::MAX;
-            while j != NIL {
-                earliest = earliest.min(self.bucket(keys.key(j).t));
-                j = self.links[j as usize].next;
+            while k != NIL {
+                let Node { ball, next } = self.nodes[k as usize];
+                if e.place(ball) == Place::overflow(k) {
+                    earliest = earliest.min(self.bucket(e.key(ball).t));
+                }
+                k = next;
             }
             if earliest == i64::MAX {
+                self.drop_overflow();
                 return false;
             }
             self.base = earliest - 1;
         }
         self.base += 1;
         if self.base & self.mask as i64 == 0 || self.in_ring == 0 {
-            self.pull_overflow(keys);
+            self.pull_overflow(e);
         }
         let slot = (self.base as u64 & self.mask) as usize;
-        let mut j = self.head[slot];
+        let mut k = self.head[slot];
         self.head[slot] = NIL;
-        while j != NIL {
-            let n = self.links[j as usize].next;
-            self.in_ring -= 1;
-            self.links[j as usize].place = Place::Nowhere;
-            self.heap_push(keys, j);
-            j = n;
+        while k != NIL {
+            let Node { ball, next } = self.nodes[k as usize];
+            if e.place(ball) == Place::ring(k) {
+                self.in_ring -= 1;
+                self.heap_push(e, ball);
+            }
+            self.recycle(k);
+            k = next;
         }
         true
     }
 
-    /// Moves overflow entries that now fall inside the ring's window into it.
-    fn pull_overflow<K: Keys + ?Sized>(&mut self, keys: &K) {
-        let mut j = self.overflow;
-        while j != NIL {
-            let n = self.links[j as usize].next;
-            if self.bucket(keys.key(j).t) - self.base < self.ring_len() {
-                self.remove(keys, j);
-                self.insert(keys, j);
+    /// Recycles every node of the overflow list (all of them dead).
+    fn drop_overflow(&mut self) {
+        let mut k = self.overflow;
+        self.overflow = NIL;
+        while k != NIL {
+            let next = self.nodes[k as usize].next;
+            self.recycle(k);
+            k = next;
+        }
+    }
+
+    /// Moves overflow entries that now fall inside the ring's window into it, and drops dead ones.
+    fn pull_overflow<E: Entries + ?Sized>(&mut self, e: &mut E) {
+        let mut k = self.overflow;
+        self.overflow = NIL;
+        while k != NIL {
+            let Node { ball, next } = self.nodes[k as usize];
+            if e.place(ball) != Place::overflow(k) {
+                self.recycle(k);
+            } else if self.bucket(e.key(ball).t) - self.base < self.ring_len() {
+                self.recycle(k);
+                e.set_place(ball, Place::NOWHERE);
+                self.insert(e, ball);
+            } else {
+                self.nodes[k as usize].next = self.overflow;
+                self.overflow = k;
             }
-            j = n;
+            k = next;
         }
     }
 
     #[inline]
-    fn less<K: Keys + ?Sized>(keys: &K, a: u32, b: u32) -> bool {
-        let (ka, kb) = (keys.key(a), keys.key(b));
+    fn less<E: Entries + ?Sized>(e: &E, a: u32, b: u32) -> bool {
+        let (ka, kb) = (e.key(a), e.key(b));
         match ka.t.total_cmp(&kb.t) {
             Ordering::Less => true,
             Ordering::Greater => false,
@@ -240,28 +274,28 @@ impl Calendar {
         }
     }
 
-    fn heap_push<K: Keys + ?Sized>(&mut self, keys: &K, i: u32) {
+    fn heap_push<E: Entries + ?Sized>(&mut self, e: &mut E, i: u32) {
         self.heap.push(i);
         let k = self.heap.len() - 1;
-        self.links[i as usize].place = Place::Heap(k as u32);
-        self.sift_up(keys, k);
+        e.set_place(i, Place::heap(k));
+        self.sift_up(e, k);
     }
 
-    fn heap_remove<K: Keys + ?Sized>(&mut self, keys: &K, k: usize) {
+    fn heap_remove<E: Entries + ?Sized>(&mut self, e: &mut E, k: usize) {
         let last = self.heap.pop().expect("the entry is in the heap");
         if k < self.heap.len() {
             self.heap[k] = last;
-            self.links[last as usize].place = Place::Heap(k as u32);
-            let k = self.sift_up(keys, k);
-            self.sift_down(keys, k);
+            e.set_place(last, Place::heap(k));
+            let k = self.sift_up(e, k);
+            self.sift_down(e, k);
         }
     }
 
-    fn sift_up<K: Keys + ?Sized>(&mut self, keys: &K, mut k: usize) -> usize {
+    fn sift_up<E: Entries + ?Sized>(&mut self, e: &mut E, mut k: usize) -> usize {
         while k > 0 {
             let p = (k - 1) / 2;
-            if Self::less(keys, self.heap[k], self.heap[p]) {
-                self.swap(k, p);
+            if Self::less(e, self.heap[k], self.heap[p]) {
+                self.swap(e, k, p);
                 k = p;
             } else {
                 break;
@@ -270,35 +304,35 @@ impl Calendar {
         k
     }
 
-    fn sift_down<K: Keys + ?Sized>(&mut self, keys: &K, mut k: usize) {
+    fn sift_down<E: Entries + ?Sized>(&mut self, e: &mut E, mut k: usize) {
         loop {
             let (l, r) = (2 * k + 1, 2 * k + 2);
             let mut m = k;
-            if l < self.heap.len() && Self::less(keys, self.heap[l], self.heap[m]) {
+            if l < self.heap.len() && Self::less(e, self.heap[l], self.heap[m]) {
                 m = l;
             }
-            if r < self.heap.len() && Self::less(keys, self.heap[r], self.heap[m]) {
+            if r < self.heap.len() && Self::less(e, self.heap[r], self.heap[m]) {
                 m = r;
             }
             if m == k {
                 return;
             }
-            self.swap(k, m);
+            self.swap(e, k, m);
             k = m;
         }
     }
 
     #[inline]
-    fn swap(&mut self, a: usize, b: usize) {
+    fn swap<E: Entries + ?Sized>(&mut self, e: &mut E, a: usize, b: usize) {
         self.heap.swap(a, b);
-        self.links[self.heap[a] as usize].place = Place::Heap(a as u32);
-        self.links[self.heap[b] as usize].place = Place::Heap(b as u32);
+        e.set_place(self.heap[a], Place::heap(a));
+        e.set_place(self.heap[b], Place::heap(b));
     }
 
     /// Bytes of memory held.
     pub fn memory_bytes(&self) -> usize {
         4 * (self.head.len() + self.heap.capacity())
-            + std::mem::size_of::<Link>() * self.links.len()
+            + std::mem::size_of::<Node>() * self.nodes.capacity()
     }
 }
 
@@ -308,40 +342,90 @@ mod tests {
     use crate::vtime::pair;
     use proptest::prelude::*;
 
+    /// Keys and places in plain vectors.
+    struct Plain {
+        keys: Vec<Key>,
+        places: Vec<Place>,
+    }
+
+    impl Entries for Plain {
+        fn key(&self, i: u32) -> &Key {
+            &self.keys[i as usize]
+        }
+        fn place(&self, i: u32) -> Place {
+            self.places[i as usize]
+        }
+        fn set_place(&mut self, i: u32, place: Place) {
+            self.places[i as usize] = place;
+        }
+    }
+
     proptest! {
-        /// Any sequence of sets and pops yields balls in exact key order, like a sorted list.
+        /// Any sequence of sets and pops yields balls in exact key order, like a sorted list,
+        /// and dead nodes are recycled: the pool never outgrows the sets made.
         #[test]
         fn pops_in_key_order(
             n in 1usize..40,
             ops in proptest::collection::vec((0u32..40, 0.0..50.0f64, 0u32..3, any::<bool>()), 1..300),
             gap in 0.01..10.0f64,
         ) {
-            let mut keys: Vec<Key> = (0..n).map(|_| Key::at(f64::INFINITY, 0)).collect();
+            let mut e = Plain {
+                keys: (0..n).map(|_| Key::at(f64::INFINITY, 0)).collect(),
+                places: vec![Place::NOWHERE; n],
+            };
             let mut cal = Calendar::new(n, 0.0, gap);
             let mut now = 0.0f64;
+            let mut sets = 0;
             for (i, dt, tie, pop) in ops {
                 let i = i % n as u32;
                 if pop {
                     let want = (0..n as u32)
-                        .filter(|&b| keys[b as usize].t.is_finite())
-                        .min_by(|&a, &b| keys[a as usize].cmp(&keys[b as usize]));
-                    let got = cal.first(&keys[..]);
+                        .filter(|&b| e.keys[b as usize].t.is_finite())
+                        .min_by(|&a, &b| e.keys[a as usize].cmp(&e.keys[b as usize]));
+                    let got = cal.first(&mut e);
                     prop_assert_eq!(
-                        got.map(|g| keys[g as usize].clone()),
-                        want.map(|w| keys[w as usize].clone())
+                        got.map(|g| e.keys[g as usize].clone()),
+                        want.map(|w| e.keys[w as usize].clone())
                     );
                     if let Some(g) = got {
-                        now = keys[g as usize].t;
-                        keys[g as usize] = Key::at(f64::INFINITY, 0);
-                        cal.set(&keys[..], g);
+                        now = e.keys[g as usize].t;
+                        e.keys[g as usize] = Key::at(f64::INFINITY, 0);
+                        cal.set(&mut e, g);
                     }
                 } else {
                     // times never go before the last popped one, as in a simulation
                     let t = if tie == 0 { now } else { now + (dt * tie as f64).round() / 4.0 };
-                    keys[i as usize] = Key::at(t, pair(i, 100 + tie));
-                    cal.set(&keys[..], i);
+                    e.keys[i as usize] = Key::at(t, pair(i, 100 + tie));
+                    cal.set(&mut e, i);
+                    sets += 1;
                 }
             }
+            prop_assert!(cal.nodes.len() <= sets);
         }
+    }
+
+    /// Moving the same events again and again while time advances keeps the node pool at the
+    /// size of the live entries plus the dead ones of one ring revolution, not the sets made.
+    #[test]
+    fn dead_nodes_are_recycled() {
+        let n = 64;
+        let mut e = Plain {
+            keys: (0..n).map(|i| Key::at(1.0 + i as f64, 0)).collect(),
+            places: vec![Place::NOWHERE; n],
+        };
+        let mut cal = Calendar::new(n, 0.0, 1.0 / n as f64);
+        for i in 0..n as u32 {
+            cal.set(&mut e, i);
+        }
+        for _ in 0..100_000 {
+            let g = cal.first(&mut e).expect("every ball is queued");
+            let t = e.keys[g as usize].t;
+            // the popped ball and a neighbour are rescheduled a little later
+            for b in [g, (g + 1) % n as u32] {
+                e.keys[b as usize] = Key::at(t + 0.5 + f64::from(b) / n as f64, 0);
+                cal.set(&mut e, b);
+            }
+        }
+        assert!(cal.nodes.len() < 4 * n, "{} nodes", cal.nodes.len());
     }
 }

@@ -16,7 +16,7 @@
 //! event no later than `X`; if that event is popped stale, the ball recomputes and keeps one no
 //! later than `X` again. So the earliest valid event is never missed.
 
-use super::calendar::{Calendar, Keys};
+use super::calendar::{Calendar, Entries, Place};
 use super::grid::Grid;
 use super::prefetch::prefetch;
 use super::{
@@ -99,12 +99,22 @@ struct Own {
     mass: f64,
     /// The cell its centre enters at the slot's `cross_t`.
     cross_cell: u32,
+    /// Where its queued key is in the calendar.
+    place: Place,
 }
 
-impl Keys for [Own] {
+impl Entries for [Own] {
     #[inline]
     fn key(&self, i: u32) -> &Key {
         &self[i as usize].queued
+    }
+    #[inline]
+    fn place(&self, i: u32) -> Place {
+        self[i as usize].place
+    }
+    #[inline]
+    fn set_place(&mut self, i: u32, place: Place) {
+        self[i as usize].place = place;
     }
 }
 
@@ -192,6 +202,7 @@ impl EventList {
                     fixed_at: Key::start(start),
                     mass: b.mass,
                     cross_cell: 0,
+                    place: Place::NOWHERE,
                 })
                 .collect(),
             pocket: vec![None; n],
@@ -217,7 +228,8 @@ impl EventList {
         let mean = finite.iter().map(|t| t - start).sum::<f64>() / finite.len().max(1) as f64;
         e.queue = Calendar::new(n, start, mean / finite.len().max(1) as f64);
         for i in 0..n as u32 {
-            e.queue.set(&e.own[..], i);
+            e.own[i as usize].place = Place::NOWHERE;
+            e.queue.set(&mut e.own[..], i);
         }
         e
     }
@@ -371,7 +383,7 @@ impl EventList {
         } else {
             phys.clone()
         };
-        self.queue.set(&self.own[..], i);
+        self.queue.set(&mut self.own[..], i);
     }
 
     fn set_velocity(&mut self, i: u32, key: &Key, velocity: crate::geometry::Vec2) {
@@ -407,7 +419,7 @@ impl EventList {
                 until = self.now;
                 break;
             }
-            let first = self.queue.first(&self.own[..]);
+            let first = self.queue.first(&mut self.own[..]);
             if let Some(r) = &self.reversal {
                 let before = first.is_none_or(|i| *r < self.own[i as usize].queued);
                 if before && r.t <= until {
