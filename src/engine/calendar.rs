@@ -63,6 +63,8 @@ pub trait Entries {
     fn place(&self, i: u32) -> Place;
     /// Records where ball `i`'s entry is.
     fn set_place(&mut self, i: u32, place: Place);
+    /// Ball `i`'s bucket has just been opened: its event comes up soon (a hint for prefetching).
+    fn opened(&self, _i: u32) {}
 }
 
 /// A bucket list node: a ball and the next node.
@@ -225,6 +227,7 @@ impl Calendar {
             let Node { ball, next } = self.nodes[k as usize];
             if e.place(ball) == Place::ring(k) {
                 self.in_ring -= 1;
+                e.opened(ball);
                 self.heap_push(e, ball);
             }
             self.recycle(k);

@@ -103,18 +103,33 @@ struct Own {
     place: Place,
 }
 
-impl Entries for [Own] {
+/// What the calendar sees of the balls: their own records, and their slots to prefetch.
+struct Queued<'a> {
+    own: &'a mut [Own],
+    slots: &'a [Slot],
+}
+
+impl Entries for Queued<'_> {
     #[inline]
     fn key(&self, i: u32) -> &Key {
-        &self[i as usize].queued
+        &self.own[i as usize].queued
     }
     #[inline]
     fn place(&self, i: u32) -> Place {
-        self[i as usize].place
+        self.own[i as usize].place
     }
     #[inline]
     fn set_place(&mut self, i: u32, place: Place) {
-        self[i as usize].place = place;
+        self.own[i as usize].place = place;
+    }
+    /// The ball's event is a few events away: start loading the slots it will read.
+    #[inline]
+    fn opened(&self, i: u32) {
+        prefetch(&self.slots[i as usize]);
+        if let Partner::Ball(j, _) = self.own[i as usize].phys.partner {
+            prefetch(&self.slots[j as usize]);
+            prefetch(&self.own[j as usize]);
+        }
     }
 }
 
@@ -229,7 +244,13 @@ impl EventList {
         e.queue = Calendar::new(n, start, mean / finite.len().max(1) as f64);
         for i in 0..n as u32 {
             e.own[i as usize].place = Place::NOWHERE;
-            e.queue.set(&mut e.own[..], i);
+            e.queue.set(
+                &mut Queued {
+                    own: &mut e.own,
+                    slots: &e.slots,
+                },
+                i,
+            );
         }
         e
     }
@@ -383,7 +404,13 @@ impl EventList {
         } else {
             phys.clone()
         };
-        self.queue.set(&mut self.own[..], i);
+        self.queue.set(
+            &mut Queued {
+                own: &mut self.own,
+                slots: &self.slots,
+            },
+            i,
+        );
     }
 
     fn set_velocity(&mut self, i: u32, key: &Key, velocity: crate::geometry::Vec2) {
@@ -419,7 +446,10 @@ impl EventList {
                 until = self.now;
                 break;
             }
-            let first = self.queue.first(&mut self.own[..]);
+            let first = self.queue.first(&mut Queued {
+                own: &mut self.own,
+                slots: &self.slots,
+            });
             if let Some(r) = &self.reversal {
                 let before = first.is_none_or(|i| *r < self.own[i as usize].queued);
                 if before && r.t <= until {
