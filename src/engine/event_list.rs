@@ -84,6 +84,9 @@ struct Slot {
 
 const NOT_ON_TABLE: u32 = u32::MAX;
 
+/// The balls in the 3 × 3 cells around a ball.
+type Near = SmallVec<[u32; 48]>;
+
 /// The rest of a ball's state, read only when the ball itself is handled (never by a neighbour's
 /// prediction): two cache lines, so handling a ball costs few trips to memory.
 #[derive(Clone, Debug)]
@@ -333,19 +336,33 @@ impl EventList {
 
     /// Recomputes ball `i`'s earliest physical event and its next cell crossing from scratch.
     fn predict(&mut self, i: u32) {
-        let b = self.slots[i as usize];
-        let mut best = Best::none();
-        if b.cell != NOT_ON_TABLE {
-            // Gather the neighbours first and ask for all their records at once, so their
-            // trips to memory overlap instead of following one another.
-            let mut near = SmallVec::<[u32; 48]>::new();
-            self.grid.for_each_near(b.cell, |j| {
+        let near = self.gather(i);
+        self.predict_among(i, &near);
+    }
+
+    /// The balls near ball `i` (none once pocketed), with a request to load their slots: gathered
+    /// ahead of the pair tests so that the trips to memory overlap instead of following one
+    /// another.
+    fn gather(&self, i: u32) -> Near {
+        let mut near = Near::new();
+        let cell = self.slots[i as usize].cell;
+        if cell != NOT_ON_TABLE {
+            self.grid.for_each_near(cell, |j| {
                 if j != i {
                     prefetch(&self.slots[j as usize]);
                     near.push(j);
                 }
             });
-            for &j in &near {
+        }
+        near
+    }
+
+    /// [`EventList::predict`] with ball `i`'s neighbours already gathered.
+    fn predict_among(&mut self, i: u32, near: &[u32]) {
+        let b = self.slots[i as usize];
+        let mut best = Best::none();
+        if b.cell != NOT_ON_TABLE {
+            for &j in near {
                 self.offer_ball(i, &b, j, &mut best);
             }
             let tests = near.len() as u64 + self.offer_fixed(i, &b, b.cell, &mut best);
@@ -519,8 +536,9 @@ impl EventList {
                     );
                     self.set_velocity(a, &key, va);
                     self.set_velocity(b, &key, vb);
-                    self.predict(a);
-                    self.predict(b);
+                    let (near_a, near_b) = (self.gather(a), self.gather(b));
+                    self.predict_among(a, &near_a);
+                    self.predict_among(b, &near_b);
                     self.emit(&key, EventKind::BallBall, a, b, &mut counts, obs)?;
                 }
                 Partner::Fixed(f) => {
