@@ -377,17 +377,20 @@ impl EventList {
     /// 3 × 3 block are new candidates; its physical prediction otherwise stands.
     fn cross(&mut self, i: u32, to: u32) {
         let from = self.slots[i as usize].cell;
-        self.grid.remove(i);
+        let mut near = Near::new();
+        self.grid.for_each_entering(from, to, |j| {
+            prefetch(&self.slots[j as usize]);
+            near.push(j);
+        });
+        self.grid.remove_from(i, from);
         self.grid.insert(i, to);
         self.slots[i as usize].cell = to;
         let b = self.slots[i as usize];
         let mut best = std::mem::replace(&mut self.own[i as usize].phys, Best::none());
-        let mut tests = 0u64;
-        self.grid.for_each_entering(from, to, |j| {
-            tests += 1;
+        for &j in &near {
             self.offer_ball(i, &b, j, &mut best);
-        });
-        tests += self.offer_fixed(i, &b, to, &mut best);
+        }
+        let tests = near.len() as u64 + self.offer_fixed(i, &b, to, &mut best);
         self.stats.predictions += tests;
         self.own[i as usize].phys = best;
         self.set_exit(i);
