@@ -106,10 +106,12 @@ struct Own {
     place: Place,
 }
 
-/// What the calendar sees of the balls: their own records, and their slots to prefetch.
+/// What the calendar sees of the balls: their own records, and their slots and cells to
+/// prefetch.
 struct Queued<'a> {
     own: &'a mut [Own],
     slots: &'a [Slot],
+    grid: &'a Grid,
 }
 
 impl Entries for Queued<'_> {
@@ -128,8 +130,11 @@ impl Entries for Queued<'_> {
     /// The ball's event is a few events away: start loading the slots it will read.
     #[inline]
     fn opened(&self, i: u32) {
+        let own = &self.own[i as usize];
         prefetch(&self.slots[i as usize]);
-        if let Partner::Ball(j, _) = self.own[i as usize].phys.partner {
+        if own.queued.path[..] == [CELL_CROSSING] {
+            self.grid.prefetch_near(own.cross_cell);
+        } else if let Partner::Ball(j, _) = own.phys.partner {
             prefetch(&self.slots[j as usize]);
             prefetch(&self.own[j as usize]);
         }
@@ -251,6 +256,7 @@ impl EventList {
                 &mut Queued {
                     own: &mut e.own,
                     slots: &e.slots,
+                    grid: &e.grid,
                 },
                 i,
             );
@@ -428,6 +434,7 @@ impl EventList {
             &mut Queued {
                 own: &mut self.own,
                 slots: &self.slots,
+                grid: &self.grid,
             },
             i,
         );
@@ -469,6 +476,7 @@ impl EventList {
             let first = self.queue.first(&mut Queued {
                 own: &mut self.own,
                 slots: &self.slots,
+                grid: &self.grid,
             });
             if let Some(r) = &self.reversal {
                 let before = first.is_none_or(|i| *r < self.own[i as usize].queued);
