@@ -1,8 +1,9 @@
 //! The sequential executor: one pending set, batches run strictly in order.
 
 use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime};
+use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, HashSet};
+use std::collections::BinaryHeap;
 
 /// Receives each output with the model and the states just after the batch that produced it.
 pub type Sink<'a, M, E> =
@@ -37,7 +38,7 @@ pub struct Sequential<M: Model> {
     states: Vec<M::State>,
     seqs: Vec<u64>,
     pending: BinaryHeap<Item<M::Msg>>,
-    cancelled: HashSet<Handle>,
+    cancelled: FxHashSet<Handle>,
     stats: MessageStats,
     now: Option<VTime>,
 }
@@ -51,7 +52,7 @@ impl<M: Model> Sequential<M> {
             model,
             states,
             pending: BinaryHeap::new(),
-            cancelled: HashSet::new(),
+            cancelled: FxHashSet::default(),
             stats: MessageStats::default(),
             now: None,
         };
