@@ -11,6 +11,12 @@
 //! trajectories and the keys at which they were fixed, so the order of simultaneous and
 //! instantaneous events is exactly the canonical one of DESIGN.md whichever ball discovers them.
 //!
+//! Memory: at a million balls every record an event touches is a trip to main memory, so the
+//! layout serves the access pattern. What a neighbour's prediction reads is one cache line per
+//! ball ([`Slot`]); what only the ball itself reads is two more ([`Own`], which also holds the
+//! ball's place in the calendar); neighbours are gathered and prefetched before the pair tests,
+//! and a ball's records are prefetched when its calendar bucket opens, a few events ahead.
+//!
 //! Why one event per ball is enough: for any pair whose next contact is at key `X`, the ball of
 //! the pair that last recomputed its events did so with both current trajectories and kept an
 //! event no later than `X`; if that event is popped stale, the ball recomputes and keeps one no
