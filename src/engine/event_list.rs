@@ -13,7 +13,7 @@
 //!
 //! Memory: at a million balls every record an event touches is a trip to main memory, so the
 //! layout serves the access pattern. What a neighbour's prediction reads is one cache line per
-//! ball ([`Slot`]); what only the ball itself reads is two more ([`Own`], which also holds the
+//! ball (`Slot`); what only the ball itself reads is two more (`Own`, which also holds the
 //! ball's place in the calendar); neighbours are gathered and prefetched before the pair tests,
 //! and a ball's records are prefetched when its calendar bucket opens, a few events ahead.
 //!
