@@ -78,6 +78,40 @@ pub struct BenchRow {
     pub rss_mib: f64,
 }
 
+/// How the event-list engine's cost per event grows with the ball count at one area fraction:
+/// the cost at the largest count measured over the cost at the smallest.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Growth {
+    /// Area fraction.
+    pub area_fraction: f64,
+    /// The smallest ball count measured.
+    pub from_balls: usize,
+    /// The largest ball count measured.
+    pub to_balls: usize,
+    /// Nanoseconds per event at `to_balls` over nanoseconds per event at `from_balls`.
+    pub ratio: f64,
+}
+
+/// The growth of the cost per event for every area fraction measured at two ball counts or more.
+pub fn growth(rows: &[BenchRow]) -> Vec<Growth> {
+    let mut phis: Vec<f64> = rows.iter().map(|r| r.area_fraction).collect();
+    phis.sort_by(f64::total_cmp);
+    phis.dedup();
+    phis.iter()
+        .filter_map(|&phi| {
+            let at: Vec<&BenchRow> = rows.iter().filter(|r| r.area_fraction == phi).collect();
+            let lo = at.iter().min_by_key(|r| r.balls)?;
+            let hi = at.iter().max_by_key(|r| r.balls)?;
+            (hi.balls > lo.balls).then(|| Growth {
+                area_fraction: phi,
+                from_balls: lo.balls,
+                to_balls: hi.balls,
+                ratio: hi.ns_per_event / lo.ns_per_event,
+            })
+        })
+        .collect()
+}
+
 /// A line describing this machine: processor model, logical cores, OS.
 pub fn machine() -> String {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
@@ -199,7 +233,14 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             rows.push(r);
         }
     }
+    let growth = growth(&rows);
     if !a.json {
+        for g in &growth {
+            println!(
+                "cost per event at {} balls / at {} balls, phi {:.2}: {:.2}",
+                g.to_balls, g.from_balls, g.area_fraction, g.ratio
+            );
+        }
         println!();
         println!("objects engine (thesis fig. 3, sequential, non-sectored), thesis gas until 4");
         ObjectsRow::print_header();
@@ -249,7 +290,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     if a.json {
         println!(
             "{}",
-            json!({"machine": m, "engine": "event-list", "rows": rows,
+            json!({"machine": m, "engine": "event-list", "rows": rows, "growth": growth,
                    "objects": objects, "sectored": sectored, "phold": phold})
         );
     } else {
@@ -354,4 +395,42 @@ pub fn measure_objects(
         messages: out.messages.iter().map(|(_, c)| c).sum(),
         seconds,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(balls: usize, area_fraction: f64, ns_per_event: f64) -> BenchRow {
+        BenchRow {
+            balls,
+            area_fraction,
+            events: 1,
+            setup_seconds: 0.0,
+            seconds: 0.0,
+            events_per_second: 0.0,
+            ns_per_event,
+            rss_mib: 0.0,
+        }
+    }
+
+    #[test]
+    fn growth_is_largest_over_smallest_count_per_area_fraction() {
+        let rows = [
+            row(1024, 0.3, 700.0),
+            row(1024, 0.6, 650.0),
+            row(10_000, 0.3, 800.0),
+            row(1_000_000, 0.3, 2100.0),
+            row(1_000_000, 0.6, 1300.0),
+            row(500, 0.5, 600.0),
+        ];
+        let g = growth(&rows);
+        assert_eq!(g.len(), 2, "0.5 was measured at one count only");
+        assert_eq!(
+            (g[0].area_fraction, g[0].from_balls, g[0].to_balls),
+            (0.3, 1024, 1_000_000)
+        );
+        assert_eq!(g[0].ratio, 3.0);
+        assert_eq!((g[1].area_fraction, g[1].ratio), (0.6, 2.0));
+    }
 }

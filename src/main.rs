@@ -958,8 +958,19 @@ fn demo(json: bool, out: &std::path::Path) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Lets a closed pipe end the process quietly, as it does every Unix filter (`poolsim bench |
+/// head`): Rust ignores SIGPIPE, and printing to a closed pipe would then panic.
+fn die_quietly_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: restores the default action of one signal before any thread is started.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
     keep_freed_memory();
+    die_quietly_on_closed_pipe();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => e.exit(), // --help, --version

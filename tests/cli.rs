@@ -726,3 +726,48 @@ fn a_memory_budget_too_small_for_one_instant_is_a_clear_error() {
     );
     assert!(line.contains("--tw-memory"), "{line}");
 }
+
+/// A reader that stops early (`poolsim … | head`) ends the run quietly: no panic, no error text.
+#[test]
+fn a_closed_pipe_ends_the_run_quietly() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    for args in [
+        &[
+            "run",
+            "gas",
+            "--balls",
+            "400",
+            "--until",
+            "200",
+            "--trace",
+            "/dev/stdout",
+        ][..],
+        &[
+            "bench",
+            "--balls",
+            "1000",
+            "--area-fractions",
+            "0.5",
+            "--events",
+            "20000",
+        ][..],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_poolsim"))
+            .args(args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the poolsim binary runs");
+        let mut first = String::new();
+        BufReader::new(child.stdout.take().expect("stdout is piped"))
+            .read_line(&mut first)
+            .expect("one line comes");
+        assert!(!first.is_empty(), "{args:?}");
+        let out = child.wait_with_output().expect("poolsim ends");
+        let err = text(&out.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert_ne!(out.status.code(), Some(101), "{args:?}: {err}");
+    }
+}
