@@ -1,9 +1,9 @@
 //! The sequential executor: one pending set, batches run strictly in order.
 
 use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime};
+use dary_heap::QuaternaryHeap;
 use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 
 /// Receives each output with the model and the states just after the batch that produced it.
 pub type Sink<'a, M, E> =
@@ -37,7 +37,7 @@ pub struct Sequential<M: Model> {
     model: M,
     states: Vec<M::State>,
     seqs: Vec<u64>,
-    pending: BinaryHeap<Item<M::Msg>>,
+    pending: QuaternaryHeap<Item<M::Msg>>,
     cancelled: FxHashSet<Handle>,
     stats: MessageStats,
     now: Option<VTime>,
@@ -51,7 +51,7 @@ impl<M: Model> Sequential<M> {
             seqs: vec![0; states.len()],
             model,
             states,
-            pending: BinaryHeap::new(),
+            pending: QuaternaryHeap::new(),
             cancelled: FxHashSet::default(),
             stats: MessageStats::default(),
             now: None,

@@ -38,12 +38,13 @@ pub mod mpi;
 pub mod threads;
 
 use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime};
+use dary_heap::QuaternaryHeap;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
 use smallvec::SmallVec;
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, VecDeque};
+use std::collections::VecDeque;
 
 /// Time Warp's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -449,7 +450,7 @@ pub struct Worker<M: Model> {
     placement: std::sync::Arc<Placement>,
     lps: Vec<Lp<M>>,
     entries: FxHashMap<u64, Entry<M::Msg>>,
-    heap: BinaryHeap<Item>,
+    heap: QuaternaryHeap<Item>,
     local_ops: Vec<Op<M::Msg>>,
     outbox: Vec<Vec<Op<M::Msg>>>,
     /// Chaos mode: its random stream and the ops it holds back.
@@ -510,7 +511,7 @@ impl<M: Model> Worker<M> {
                 .collect(),
             placement,
             entries: FxHashMap::default(),
-            heap: BinaryHeap::new(),
+            heap: QuaternaryHeap::new(),
             local_ops: Vec::new(),
             outbox: (0..workers).map(|_| Vec::new()).collect(),
             chaos: chaos.map(|s| Chaos {
