@@ -258,14 +258,8 @@ impl EventList {
         e.queue = Calendar::new(n, start, mean / finite.len().max(1) as f64);
         for i in 0..n as u32 {
             e.own[i as usize].place = Place::NOWHERE;
-            e.queue.set(
-                &mut Queued {
-                    own: &mut e.own,
-                    slots: &e.slots,
-                    grid: &e.grid,
-                },
-                i,
-            );
+            let (queue, mut balls) = e.calendar();
+            queue.set(&mut balls, i);
         }
         e
     }
@@ -278,6 +272,16 @@ impl EventList {
     /// The engine's counters so far.
     pub fn stats(&self) -> Stats {
         self.stats
+    }
+
+    /// The calendar, and what it sees of the balls.
+    fn calendar(&mut self) -> (&mut Calendar, Queued<'_>) {
+        let balls = Queued {
+            own: &mut self.own,
+            slots: &self.slots,
+            grid: &self.grid,
+        };
+        (&mut self.queue, balls)
     }
 
     /// Bytes of memory held by the engine's own tables (not counting the scenario).
@@ -436,14 +440,8 @@ impl EventList {
         } else {
             phys.clone()
         };
-        self.queue.set(
-            &mut Queued {
-                own: &mut self.own,
-                slots: &self.slots,
-                grid: &self.grid,
-            },
-            i,
-        );
+        let (queue, mut balls) = self.calendar();
+        queue.set(&mut balls, i);
     }
 
     fn set_velocity(&mut self, i: u32, key: &Key, velocity: crate::geometry::Vec2) {
@@ -479,11 +477,8 @@ impl EventList {
                 until = self.now;
                 break;
             }
-            let first = self.queue.first(&mut Queued {
-                own: &mut self.own,
-                slots: &self.slots,
-                grid: &self.grid,
-            });
+            let (queue, mut balls) = self.calendar();
+            let first = queue.first(&mut balls);
             if let Some(r) = &self.reversal {
                 let before = first.is_none_or(|i| *r < self.own[i as usize].queued);
                 if before && r.t <= until {
