@@ -645,20 +645,9 @@ fn every_scenario_file_passes_check() {
 
 #[test]
 fn time_warp_runs_checked_and_reports_its_statistics() {
-    let v = success_json(&[
-        "run",
-        "gas",
-        "--balls",
-        "64",
-        "--sectors",
-        "4",
-        "--engine",
-        "time-warp",
-        "--workers",
-        "2",
-        "--check",
-        "--json",
-    ]);
+    let gas = ["run", "gas", "--balls", "64", "--sectors", "4", "--json"];
+    let tw_args = ["--engine", "time-warp", "--workers", "2", "--check"];
+    let v = success_json(&[&gas[..], &tw_args[..]].concat());
     assert_eq!(v["engine"], "time-warp");
     let tw = &v["time_warp"];
     assert_eq!(u(&tw["workers"]), 2);
@@ -668,17 +657,7 @@ fn time_warp_runs_checked_and_reports_its_statistics() {
         f(&tw["efficiency"]),
         u(&tw["committed"]) as f64 / u(&tw["processed"]) as f64
     );
-    let seq = success_json(&[
-        "run",
-        "gas",
-        "--balls",
-        "64",
-        "--sectors",
-        "4",
-        "--engine",
-        "objects",
-        "--json",
-    ]);
+    let seq = success_json(&[&gas[..], &["--engine", "objects"][..]].concat());
     assert_eq!(v["final_state_digest"], seq["final_state_digest"]);
 }
 
