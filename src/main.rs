@@ -481,6 +481,10 @@ impl Observer for Progress {
         }
         Ok(())
     }
+
+    fn reads_balls(&self) -> bool {
+        false
+    }
 }
 
 fn load(spec: &str, gen: &GenArgs) -> Result<Scenario, Failure> {
@@ -783,6 +787,11 @@ impl<W: std::io::Write> Observer for Sinks<'_, W> {
             p.on_event(ev, world)?;
         }
         Ok(())
+    }
+
+    fn reads_balls(&self) -> bool {
+        self.trace.as_ref().is_some_and(|t| t.reads_balls())
+            || self.progress.as_ref().is_some_and(|p| p.reads_balls())
     }
 }
 

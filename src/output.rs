@@ -53,6 +53,10 @@ impl<W: Write> Observer for TraceWriter<W> {
             .write_all(b"\n")
             .map_err(|e| RunError::Output(e.to_string()))
     }
+
+    fn reads_balls(&self) -> bool {
+        false
+    }
 }
 
 /// Keeps every event's trace line in memory (for tests and for comparing engines).
@@ -66,6 +70,10 @@ impl Observer for TraceRecorder {
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
         self.lines.push(TraceLine::new(ev, world.table()));
         Ok(())
+    }
+
+    fn reads_balls(&self) -> bool {
+        false
     }
 }
 

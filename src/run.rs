@@ -151,6 +151,10 @@ impl Observer for Sinks<'_> {
         self.user.on_event(ev, world)
     }
 
+    fn reads_balls(&self) -> bool {
+        self.checker.is_some() || self.user.reads_balls()
+    }
+
     fn on_frame(&mut self, frame: &Frame, table: &Table) -> Result<(), RunError> {
         self.user.on_frame(frame, table)
     }
@@ -346,6 +350,10 @@ pub fn reverse(
                 self.0 += 1;
             }
             Ok(())
+        }
+
+        fn reads_balls(&self) -> bool {
+            false
         }
     }
     let cfg = RunConfig {

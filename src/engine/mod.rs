@@ -325,6 +325,12 @@ pub trait Observer {
     /// Called after each event; an error stops the run.
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError>;
 
+    /// Whether `on_event` reads balls from the world (its table aside). An executor that keeps
+    /// the balls' states on other threads (Time Warp) ships them only when some observer does.
+    fn reads_balls(&self) -> bool {
+        true
+    }
+
     /// Called with each frame, in time order, when the run was asked for frames.
     fn on_frame(&mut self, _frame: &Frame, _table: &Table) -> Result<(), RunError> {
         Ok(())
@@ -338,11 +344,19 @@ impl Observer for Ignore {
     fn on_event(&mut self, _: &Event, _: &dyn World) -> Result<(), RunError> {
         Ok(())
     }
+
+    fn reads_balls(&self) -> bool {
+        false
+    }
 }
 
 impl<O: Observer + ?Sized> Observer for &mut O {
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
         (**self).on_event(ev, world)
+    }
+
+    fn reads_balls(&self) -> bool {
+        (**self).reads_balls()
     }
 
     fn on_frame(&mut self, frame: &Frame, table: &Table) -> Result<(), RunError> {

@@ -88,14 +88,23 @@ where
         }
     }
 
-    /// Runs every batch up to `until`, each output to `sink`.
-    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, RunError>) -> Result<(), RunError> {
+    /// Runs every batch up to `until`, each output to `sink`, which reads the balls' states
+    /// only if `reads_balls`.
+    fn run(
+        &mut self,
+        until: f64,
+        reads_balls: bool,
+        sink: &mut Sink<'_, M, RunError>,
+    ) -> Result<(), RunError> {
         match self {
             Exec::Sequential(e) => e.run(until, sink),
-            Exec::TimeWarp(e) => e.run(until, sink).map_err(|e| match e {
-                TwError::Sink(e) => e,
-                TwError::Failed(m) => RunError::TimeWarp(m),
-            }),
+            Exec::TimeWarp(e) => {
+                e.ship_states(reads_balls);
+                e.run(until, sink).map_err(|e| match e {
+                    TwError::Sink(e) => e,
+                    TwError::Failed(m) => RunError::TimeWarp(m),
+                })
+            }
         }
     }
 }
@@ -212,14 +221,18 @@ impl Objects {
             Objects::Plain(e) => run_plain(e, until, obs),
             Objects::Sectored(e) => {
                 let mut counts = EventCounts::default();
-                e.run(until, &mut |model: &Sectored, states, ev| {
-                    counts.add(ev.kind);
-                    let view = View {
-                        table: model.table(),
-                        states,
-                    };
-                    obs.on_event(&ev, &view)
-                })?;
+                e.run(
+                    until,
+                    obs.reads_balls(),
+                    &mut |model: &Sectored, states, ev| {
+                        counts.add(ev.kind);
+                        let view = View {
+                            table: model.table(),
+                            states,
+                        };
+                        obs.on_event(&ev, &view)
+                    },
+                )?;
                 Ok(outcome(e, e.model().table(), until, counts))
             }
         }
@@ -281,34 +294,38 @@ fn run_plain(
         let n = exec.model().table().n_balls as usize;
         // A frame is complete when every ball has drawn itself for it.
         let mut frame: Option<Frame> = None;
-        exec.run(until, &mut |model: &Pool, states, out| match out {
-            PoolOutput::Event(ev) => {
-                counts.add(ev.kind);
-                let view = View {
-                    table: model.table(),
-                    states,
-                };
-                obs.on_event(&ev, &view)
-            }
-            PoolOutput::Draw { t, ball, state } => {
-                let f = frame.get_or_insert_with(|| Frame {
-                    t,
-                    balls: Vec::with_capacity(n),
-                });
-                debug_assert_eq!(f.balls.len(), ball as usize, "balls draw in order");
-                f.balls.push(BallState {
-                    traj: state.traj,
-                    radius: state.radius,
-                    mass: state.mass,
-                    pocket: state.pocket,
-                });
-                if f.balls.len() == n {
-                    let done = frame.take().expect("a frame is being drawn");
-                    obs.on_frame(&done, model.table())?;
+        exec.run(
+            until,
+            obs.reads_balls(),
+            &mut |model: &Pool, states, out| match out {
+                PoolOutput::Event(ev) => {
+                    counts.add(ev.kind);
+                    let view = View {
+                        table: model.table(),
+                        states,
+                    };
+                    obs.on_event(&ev, &view)
                 }
-                Ok(())
-            }
-        })?;
+                PoolOutput::Draw { t, ball, state } => {
+                    let f = frame.get_or_insert_with(|| Frame {
+                        t,
+                        balls: Vec::with_capacity(n),
+                    });
+                    debug_assert_eq!(f.balls.len(), ball as usize, "balls draw in order");
+                    f.balls.push(BallState {
+                        traj: state.traj,
+                        radius: state.radius,
+                        mass: state.mass,
+                        pocket: state.pocket,
+                    });
+                    if f.balls.len() == n {
+                        let done = frame.take().expect("a frame is being drawn");
+                        obs.on_frame(&done, model.table())?;
+                    }
+                    Ok(())
+                }
+            },
+        )?;
         Ok(outcome(exec, exec.model().table(), until, counts))
     }
 }

@@ -923,13 +923,18 @@ impl<M: Model> Worker<M> {
     }
 
     /// Commits every batch before `gvt`: frees its saved state and messages, and returns those
-    /// the collector needs (observed states, output), in no particular order.
-    fn fossil_collect(&mut self, model: &M, gvt: f64) -> Vec<Committed<M::State, M::Output>> {
+    /// the collector needs (output, and observed states when `ship`), in no particular order.
+    fn fossil_collect(
+        &mut self,
+        model: &M,
+        gvt: f64,
+        ship: bool,
+    ) -> Vec<Committed<M::State, M::Output>> {
         let mut out = Vec::new();
         let mut still = Vec::with_capacity(self.active.len());
         for &li in &self.active {
             let lp = &mut self.lps[li as usize];
-            let observed = model.observed(lp.id);
+            let observed = ship && model.observed(lp.id);
             while lp.history.front().is_some_and(|d| d.time.t() < gvt) {
                 let d = lp.history.pop_front().expect("a batch to commit");
                 if let Some(what) = d.into_past {
@@ -1004,13 +1009,15 @@ impl<M: Model> Worker<M> {
     }
 
     /// Runs this worker until GVT passes `until` (every batch at or before it committed) or
-    /// the run is stopped; hands committed batches to the fabric's collector each round.
+    /// the run is stopped; hands committed batches to the fabric's collector each round, with
+    /// the observed objects' states when `ship`.
     pub fn run<F: Fabric<M>>(
         &mut self,
         model: &M,
         fabric: &F,
         cfg: &TwConfig,
         until: f64,
+        ship: bool,
         stop: &std::sync::atomic::AtomicBool,
     ) -> Result<(), Stop> {
         let mut buf = Vec::new();
@@ -1073,7 +1080,7 @@ impl<M: Model> Worker<M> {
                         self.auto_window = 4.0 * (gvt - self.gvt);
                     }
                     self.gvt = gvt;
-                    let batches = self.fossil_collect(model, gvt);
+                    let batches = self.fossil_collect(model, gvt, ship);
                     self.round += 1;
                     fabric.commit(Chunk {
                         worker: self.index,

@@ -122,6 +122,9 @@ pub enum TwError<E> {
 /// Committed batches of one round from every worker, merged and fed to the sink.
 pub struct Collector<M: Model> {
     states: Vec<M::State>,
+    /// Whether workers ship observed states with their batches; when not, the sink is shown no
+    /// states during the run (an empty slice), only the final ones after it.
+    shipped: bool,
     rounds: BTreeMap<u64, Vec<ChunkOf<M>>>,
     next_round: u64,
     /// Statistics of the workers' last chunks.
@@ -137,6 +140,7 @@ impl<M: Model> Collector<M> {
     pub fn new(states: Vec<M::State>) -> Collector<M> {
         Collector {
             states,
+            shipped: true,
             rounds: BTreeMap::new(),
             next_round: 1,
             stats: TwStats::default(),
@@ -198,7 +202,8 @@ impl<M: Model> Collector<M> {
                     self.states[c.obj as usize] = state;
                 }
                 for o in c.output {
-                    if let Err(e) = sink(model, &self.states, o) {
+                    let states: &[M::State] = if self.shipped { &self.states } else { &[] };
+                    if let Err(e) = sink(model, states, o) {
                         *failed = Some(TwError::Sink(e));
                         break;
                     }
@@ -328,6 +333,14 @@ where
         self.workers.iter().map(|w| w.samples().to_vec()).collect()
     }
 
+    /// Whether the workers ship every committed state of an observed object to the collector
+    /// (the default), so that the sink can read the states just after each batch. A sink that
+    /// reads none runs faster without: it is then shown an empty slice of states during the
+    /// run, and [`TimeWarp::states`] holds the final states after it.
+    pub fn ship_states(&mut self, on: bool) {
+        self.collector.shipped = on;
+    }
+
     /// Runs every batch with time at most `until` optimistically on the workers; the sink sees
     /// each output, with the committed states just after its batch, in the sequential order
     /// (on rank 0 only, under MPI).
@@ -389,8 +402,8 @@ where
             let handles: Vec<_> = workers
                 .iter_mut()
                 .map(|w| {
-                    let (stop, cfg) = (&stop, &*cfg);
-                    scope.spawn(move || w.run(model, fabric, cfg, until, stop))
+                    let (stop, cfg, ship) = (&stop, &*cfg, collector.shipped);
+                    scope.spawn(move || w.run(model, fabric, cfg, until, ship, stop))
                 })
                 .collect();
             loop {
