@@ -104,6 +104,18 @@ impl<M: Model> Sequential<M> {
         None
     }
 
+    /// Drops cancelled messages from the pending set once they are half of it, so that memory
+    /// follows the live messages (a cancelled collision may lie far in the future); what is
+    /// left in the set names messages already delivered, which no longer matter. Amortized
+    /// O(1) per cancellation.
+    fn sweep_cancelled(&mut self) {
+        if self.cancelled.len() > 1024 && 2 * self.cancelled.len() > self.pending.len() {
+            let dead = &self.cancelled;
+            self.pending.retain(|Item(p)| !dead.contains(&p.handle()));
+            self.cancelled.clear();
+        }
+    }
+
     /// Runs every batch with time at most `until`, passing each output, with the states after
     /// the batch that produced it, to `sink`; stops at the first error the sink returns.
     pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), E> {
@@ -142,6 +154,7 @@ impl<M: Model> Sequential<M> {
                 self.stats.cancels += 1;
                 self.cancelled.insert(h);
             }
+            self.sweep_cancelled();
             for p in sent {
                 self.stats.count(self.model.kind(&p.env.msg));
                 self.pending.push(Item(p));
@@ -151,5 +164,62 @@ impl<M: Model> Sequential<M> {
                 sink(&self.model, &self.states, o)?;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vtime::Key;
+
+    /// One object that, every unit of time, schedules a far-future reminder and cancels the
+    /// previous one: a pending set that kept cancelled messages would grow with every step.
+    struct Forgetful;
+
+    impl Model for Forgetful {
+        type Msg = bool;
+        type State = Option<Handle>;
+        type Output = ();
+
+        fn kind_names(&self) -> &'static [&'static str] {
+            &["Tick"]
+        }
+        fn kind(&self, _: &bool) -> usize {
+            0
+        }
+        fn priority(&self, _: &bool) -> u8 {
+            0
+        }
+        fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, _: &mut Option<Handle>) {
+            ctx.send_at(me, VTime::at(Key::start(1.0)), true);
+        }
+        fn handle(
+            &self,
+            ctx: &mut Ctx<'_, Self>,
+            me: u32,
+            reminder: &mut Option<Handle>,
+            _: &[Envelope<bool>],
+        ) {
+            let t = ctx.now().t();
+            if let Some(h) = reminder.take() {
+                ctx.cancel(h);
+            }
+            *reminder = Some(ctx.send_at(me, VTime::at(Key::start(t + 1e6)), false));
+            ctx.send_at(me, VTime::at(Key::start(t + 1.0)), true);
+        }
+    }
+
+    #[test]
+    fn cancelled_messages_do_not_pile_up() {
+        let mut s = Sequential::new(Forgetful, vec![None], VTime::at(Key::start(0.0)));
+        s.run(20_000.0, &mut |_, _, ()| Ok::<(), ()>(())).unwrap();
+        assert_eq!(s.stats().batches, 20_000);
+        assert_eq!(s.stats().cancels, 19_999);
+        // one tick and one live reminder, plus at most twice the sweep threshold of dead ones
+        assert!(
+            s.pending_len() <= 2 + 2 * 1024,
+            "{} pending",
+            s.pending_len()
+        );
     }
 }
