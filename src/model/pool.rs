@@ -170,6 +170,39 @@ pub fn cancel_with<M: Model + ?Sized>(
     }
 }
 
+/// The collisions a fixed object scheduled, by ball. A cushion hears of every ball, so this
+/// holds up to one entry per ball: a persistent map, so that cancelling costs O(1) (not a scan)
+/// and saving the state, as Time Warp does before every batch, costs O(1) too (the copy shares
+/// everything but the path an update changes).
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+pub struct Plans(
+    imbl::GenericHashMap<
+        u32,
+        Planned,
+        rustc_hash::FxBuildHasher,
+        imbl::shared_ptr::DefaultSharedPtr,
+    >,
+);
+
+impl Plans {
+    /// Records a collision scheduled with `p.partner`.
+    pub fn add(&mut self, p: Planned) {
+        self.0.insert(p.partner, p);
+    }
+
+    /// Forgets the collision with `partner`: it is happening.
+    pub fn forget(&mut self, partner: u32) {
+        self.0.remove(&partner);
+    }
+
+    /// Cancels the collision scheduled with `partner`, if any.
+    pub fn cancel_with<M: Model + ?Sized>(&mut self, ctx: &mut Ctx<'_, M>, partner: u32) {
+        if let Some(p) = self.0.remove(&partner) {
+            p.cancel(ctx);
+        }
+    }
+}
+
 /// A pool object's state.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum PoolState {
@@ -183,7 +216,7 @@ pub enum PoolState {
     /// A cushion, pocket or corner and the collisions it scheduled.
     Fixed {
         /// Collisions it scheduled.
-        planned: Vec<Planned>,
+        planned: Plans,
         /// Balls it holds (pockets only), in the order they dropped in.
         holds: Vec<u32>,
     },
@@ -235,7 +268,7 @@ impl Pool {
             .collect();
         for _ in 0..table.n_fixed() {
             states.push(PoolState::Fixed {
-                planned: Vec::new(),
+                planned: Plans::default(),
                 holds: Vec::new(),
             });
         }
@@ -482,16 +515,14 @@ impl Pool {
         &self,
         ctx: &mut Ctx<'_, Pool>,
         me: u32,
-        planned: &mut Vec<Planned>,
+        planned: &mut Plans,
         holds: &mut Vec<u32>,
         batch: &[Envelope<PoolMsg>],
     ) {
         for env in batch {
             match &env.msg {
                 PoolMsg::Collision { partner, .. } => {
-                    if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
-                        planned.swap_remove(k);
-                    }
+                    planned.forget(*partner);
                     if let Fixed::Pocket(_) = self.table.fixed(me) {
                         holds.push(*partner);
                     }
@@ -502,7 +533,7 @@ impl Pool {
                 }
                 PoolMsg::NewVelocity(x) => {
                     let from = env.from;
-                    cancel_with(ctx, planned, from);
+                    planned.cancel_with(ctx, from);
                     if x.pocket.is_none() {
                         holds.retain(|&b| b != from); // back out after a reversal
                     }
@@ -516,7 +547,7 @@ impl Pool {
                         self.contact_key(&now, contact, &x.fixed, pair(from, me), closing)
                     {
                         let p = Self::schedule(ctx, me, from, key, None, None);
-                        planned.push(p);
+                        planned.add(p);
                     }
                 }
             }

@@ -24,7 +24,7 @@
 //! on the trajectories it was predicted for. With zero delays the physical events are then exactly
 //! those of the event-list engine.
 
-use super::pool::{cancel_with, BallInfo, Planned};
+use super::pool::{cancel_with, BallInfo, Planned, Plans};
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::{Trajectory, Vec2};
 use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
@@ -261,7 +261,7 @@ pub enum SecState {
     /// A cushion, pocket or corner.
     Fixed {
         /// Collisions it scheduled.
-        planned: Vec<Planned>,
+        planned: Plans,
     },
     /// A sector.
     Sector {
@@ -317,7 +317,7 @@ impl Sectored {
         }
         for _ in 0..table.n_fixed() {
             states.push(SecState::Fixed {
-                planned: Vec::new(),
+                planned: Plans::default(),
             });
         }
         for m in members {
@@ -637,18 +637,14 @@ impl Sectored {
         &self,
         ctx: &mut Ctx<'_, Sectored>,
         me: u32,
-        planned: &mut Vec<Planned>,
+        planned: &mut Plans,
         batch: &[Envelope<SecMsg>],
     ) {
         for env in batch {
             match &env.msg {
-                SecMsg::Collision { partner, .. } => {
-                    if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
-                        planned.swap_remove(k);
-                    }
-                }
+                SecMsg::Collision { partner, .. } => planned.forget(*partner),
                 SecMsg::NewVelocity { ball, info: x } => {
-                    cancel_with(ctx, planned, *ball);
+                    planned.cancel_with(ctx, *ball);
                     if x.pocket.is_some() {
                         continue;
                     }
@@ -657,7 +653,7 @@ impl Sectored {
                         let none = Key::start(f64::NEG_INFINITY);
                         let p =
                             Self::schedule(ctx, me, *ball, key, None, none, None, x.fixed.clone());
-                        planned.push(p);
+                        planned.add(p);
                     }
                 }
                 _ => unreachable!("fixed objects hear only of trajectories and collisions"),
