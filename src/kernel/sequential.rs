@@ -1,11 +1,7 @@
-//! The sequential executor: one pending set, batches run strictly in order.
-//!
-//! The pending set is two heaps with the same order: messages for the instant being run (most
-//! of them: zero-delay relays and replies) in a small one that stays in cache, later ones in
-//! a large one; the next message is the smaller of the two tops.
+//! The sequential executor: one pending set ([`Queue`]), batches run strictly in order.
 
+use super::queue::Queue;
 use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime};
-use dary_heap::QuaternaryHeap;
 use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
 
@@ -36,62 +32,12 @@ impl<M> Ord for Item<M> {
     }
 }
 
-/// Pending messages: those of the current instant apart from later ones.
-struct Queue<M> {
-    instant: QuaternaryHeap<Item<M>>,
-    later: QuaternaryHeap<Item<M>>,
-}
-
-impl<M> Queue<M> {
-    fn new() -> Queue<M> {
-        Queue {
-            instant: QuaternaryHeap::new(),
-            later: QuaternaryHeap::new(),
-        }
-    }
-
-    /// Adds a message sent while the instant `now` runs.
-    fn push(&mut self, p: Pending<M>, now: Option<&VTime>) {
-        if now.is_some_and(|n| n.key == p.time.key) {
-            self.instant.push(Item(p));
-        } else {
-            self.later.push(Item(p));
-        }
-    }
-
-    /// The heap whose top comes first.
-    fn first(&mut self) -> &mut QuaternaryHeap<Item<M>> {
-        match (self.instant.peek(), self.later.peek()) {
-            (Some(a), Some(b)) if b.0.order(&a.0) == Ordering::Less => &mut self.later,
-            (Some(_), _) => &mut self.instant,
-            _ => &mut self.later,
-        }
-    }
-
-    fn peek(&mut self) -> Option<&Pending<M>> {
-        self.first().peek().map(|i| &i.0)
-    }
-
-    fn pop(&mut self) -> Option<Pending<M>> {
-        self.first().pop().map(|i| i.0)
-    }
-
-    fn len(&self) -> usize {
-        self.instant.len() + self.later.len()
-    }
-
-    fn retain(&mut self, mut keep: impl FnMut(&Pending<M>) -> bool) {
-        self.instant.retain(|i| keep(&i.0));
-        self.later.retain(|i| keep(&i.0));
-    }
-}
-
 /// Runs a model's objects one batch at a time in virtual-time order.
 pub struct Sequential<M: Model> {
     model: M,
     states: Vec<M::State>,
     seqs: Vec<u64>,
-    pending: Queue<M::Msg>,
+    pending: Queue<Item<M::Msg>>,
     cancelled: FxHashSet<Handle>,
     stats: MessageStats,
     now: Option<VTime>,
@@ -105,7 +51,7 @@ impl<M: Model> Sequential<M> {
             seqs: vec![0; states.len()],
             model,
             states,
-            pending: Queue::new(),
+            pending: Queue::default(),
             cancelled: FxHashSet::default(),
             stats: MessageStats::default(),
             now: None,
@@ -117,7 +63,7 @@ impl<M: Model> Sequential<M> {
             assert!(cancelled.is_empty(), "init may not cancel");
             for p in sent {
                 s.stats.count(s.model.kind(&p.env.msg));
-                s.pending.push(p, None);
+                s.pending.push(Item(p), false);
             }
         }
         s
@@ -150,7 +96,7 @@ impl<M: Model> Sequential<M> {
 
     /// Pops the next message that was not cancelled.
     fn pop_live(&mut self) -> Option<Pending<M::Msg>> {
-        while let Some(p) = self.pending.pop() {
+        while let Some(Item(p)) = self.pending.pop() {
             if !self.cancelled.remove(&p.handle()) {
                 return Some(p);
             }
@@ -165,7 +111,7 @@ impl<M: Model> Sequential<M> {
     fn sweep_cancelled(&mut self) {
         if self.cancelled.len() > 1024 && 2 * self.cancelled.len() > self.pending.len() {
             let dead = &self.cancelled;
-            self.pending.retain(|p| !dead.contains(&p.handle()));
+            self.pending.retain(|Item(p)| !dead.contains(&p.handle()));
             self.cancelled.clear();
         }
     }
@@ -175,25 +121,25 @@ impl<M: Model> Sequential<M> {
     pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), E> {
         loop {
             match self.pending.peek() {
-                Some(p) if p.time.t() <= until => {}
+                Some(Item(p)) if p.time.t() <= until => {}
                 _ => return Ok(()),
             }
             let Some(first) = self.pop_live() else {
                 return Ok(());
             };
             if first.time.t() > until {
-                self.pending.push(first, None);
+                self.pending.push(Item(first), false);
                 return Ok(());
             }
             let (time, to) = (first.time, first.to);
             let mut batch: Vec<Envelope<M::Msg>> = vec![first.env];
-            while let Some(p) = self.pending.peek() {
+            while let Some(Item(p)) = self.pending.peek() {
                 if p.to != to || p.time != time {
                     break;
                 }
                 let Some(p) = self.pop_live() else { break };
                 if p.to != to || p.time != time {
-                    self.pending.push(p, None);
+                    self.pending.push(Item(p), false);
                     break;
                 }
                 batch.push(p.env);
@@ -211,7 +157,8 @@ impl<M: Model> Sequential<M> {
             self.sweep_cancelled();
             for p in sent {
                 self.stats.count(self.model.kind(&p.env.msg));
-                self.pending.push(p, Some(&time));
+                let in_instant = p.time.key == time.key;
+                self.pending.push(Item(p), in_instant);
             }
             self.now = Some(time);
             for o in output {
