@@ -869,12 +869,13 @@ impl Model for Sectored {
         }
     }
 
-    /// Thesis 5.4: each ball sends VelocityInitialization to its sectors, which tell only the
-    /// balls after it; fixed objects hear from every ball directly.
+    /// Only the balls: observers read trajectories, never sectors or fixed objects.
     fn observed(&self, obj: u32) -> bool {
         obj < self.table.n_balls
     }
 
+    /// Thesis 5.4: each ball sends VelocityInitialization to its sectors, which tell only the
+    /// balls after it; fixed objects hear from every ball directly.
     fn init(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, state: &mut SecState) {
         if let SecState::Ball { info, sectors, .. } = state {
             for &s in sectors.iter() {
