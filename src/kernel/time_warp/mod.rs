@@ -37,12 +37,15 @@
 pub mod mpi;
 pub mod threads;
 
+mod entries;
+
+use entries::{Entries, Ref};
+
 use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime};
 use dary_heap::QuaternaryHeap;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
-use smallvec::SmallVec;
 use std::cmp::Ordering;
 use std::collections::VecDeque;
 
@@ -258,65 +261,25 @@ pub trait Fabric<M: Model>: Sync {
     fn commit(&self, chunk: Chunk<M::State, M::Output>);
 }
 
-/// A message received and not yet committed.
-struct Entry<Msg> {
-    /// Positives minus anti-messages: 1 when the message is here and not annulled.
-    pos: i8,
-    /// Model cancellations minus their undoing, by the time of the cancelling batch.
-    cancels: SmallVec<[(f64, i32); 1]>,
-    /// The message, while `pos` is 1.
-    p: Option<Pending<Msg>>,
-    /// Whether a batch not rolled back has handled it.
-    processed: bool,
-}
-
-impl<Msg> Entry<Msg> {
-    fn live(&self) -> bool {
-        self.pos == 1 && self.cancels.is_empty()
-    }
-
-    /// Counts a cancellation by a batch at `at` (`sign` 1) or its undoing (-1).
-    fn cancel(&mut self, at: f64, sign: i8) {
-        match self
-            .cancels
-            .iter()
-            .position(|c| c.0.to_bits() == at.to_bits())
-        {
-            Some(k) => {
-                self.cancels[k].1 += i32::from(sign);
-                if self.cancels[k].1 == 0 {
-                    self.cancels.swap_remove(k);
-                }
-            }
-            None => self.cancels.push((at, i32::from(sign))),
-        }
-    }
-
-    /// Whether it is dead for good once GVT is `gvt`: here and cancelled by a committed batch.
-    fn dead_for_good(&self, gvt: f64) -> bool {
-        self.pos == 1 && self.cancels.iter().any(|&(at, n)| n > 0 && at < gvt)
-    }
-}
-
-/// A heap entry: a live message's delivery order and its uid.
+/// A heap entry: a live message's delivery order and where its record is.
 struct Item {
     time: VTime,
     to: u32,
     priority: u8,
     from: u32,
     seq: u64,
-    uid: u64,
+    r: Ref,
 }
 
 impl Item {
-    fn of<M>(uid: u64, p: &Pending<M>) -> Item {
+    fn of<M>(r: Ref, p: &Pending<M>) -> Item {
         Item {
             time: p.time.clone(),
             to: p.to,
             priority: p.priority,
             from: p.env.from,
             seq: p.env.seq,
-            uid,
+            r,
         }
     }
 
@@ -327,7 +290,7 @@ impl Item {
             .then(self.priority.cmp(&o.priority))
             .then(self.from.cmp(&o.from))
             .then(self.seq.cmp(&o.seq))
-            .then(self.uid.cmp(&o.uid))
+            .then(self.r.uid.cmp(&o.r.uid))
     }
 }
 
@@ -355,6 +318,8 @@ impl Ord for Item {
 #[derive(Clone, Debug)]
 struct Sent {
     uid: u64,
+    /// Its record's slot, when the receiver is on this worker.
+    slot: Option<u32>,
     seq: u64,
     to: u32,
     time: VTime,
@@ -365,7 +330,7 @@ struct Done<M: Model> {
     time: VTime,
     pre_state: M::State,
     pre_seq: u64,
-    inputs: Vec<u64>,
+    inputs: Vec<Ref>,
     sent: Vec<(Sent, u16)>,
     cancels: Vec<Sent>,
     cancel_calls: u32,
@@ -449,9 +414,10 @@ pub struct Worker<M: Model> {
     index: usize,
     placement: std::sync::Arc<Placement>,
     lps: Vec<Lp<M>>,
-    entries: FxHashMap<u64, Entry<M::Msg>>,
+    entries: Entries<M::Msg>,
     heap: QuaternaryHeap<Item>,
-    local_ops: Vec<Op<M::Msg>>,
+    /// Ops for this worker's objects, with the slot of their message's record when known.
+    local_ops: Vec<(Op<M::Msg>, Option<u32>)>,
     outbox: Vec<Vec<Op<M::Msg>>>,
     /// Chaos mode: its random stream and the ops it holds back.
     chaos: Option<Chaos<M::Msg>>,
@@ -471,7 +437,7 @@ pub struct Worker<M: Model> {
     fault: Option<String>,
     /// Messages left dead (cancelled, annulled), with their times: fossil collection frees them
     /// once nothing can revive them.
-    graveyard: Vec<(f64, u64)>,
+    graveyard: Vec<(f64, Ref)>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
 }
@@ -510,7 +476,7 @@ impl<M: Model> Worker<M> {
                 })
                 .collect(),
             placement,
-            entries: FxHashMap::default(),
+            entries: Entries::default(),
             heap: QuaternaryHeap::new(),
             local_ops: Vec::new(),
             outbox: (0..workers).map(|_| Vec::new()).collect(),
@@ -551,16 +517,19 @@ impl<M: Model> Worker<M> {
                 self.committed_stats.count(model.kind(&p.env.msg));
                 let lp = &mut self.lps[k];
                 let uid = lp.next_uid();
+                let slot = (self.placement.worker(p.to) == self.index)
+                    .then(|| self.entries.reserve(uid).slot);
                 lp.sends.insert(
                     p.env.seq,
                     Sent {
                         uid,
+                        slot,
                         seq: p.env.seq,
                         to: p.to,
                         time: p.time.clone(),
                     },
                 );
-                self.route(Op::Msg { uid, p });
+                self.route(Op::Msg { uid, p }, slot);
             }
         }
         self.drain_local();
@@ -581,7 +550,7 @@ impl<M: Model> Worker<M> {
     /// Accepts ops handed over outside a fabric (at set-up).
     pub fn accept(&mut self, ops: Vec<Op<M::Msg>>) {
         for op in ops {
-            self.apply(op);
+            self.apply(op, None);
         }
         self.drain_local();
     }
@@ -589,7 +558,7 @@ impl<M: Model> Worker<M> {
     /// Live messages waiting (not handled) on this worker.
     pub fn pending_len(&self) -> usize {
         self.entries
-            .values()
+            .iter()
             .filter(|e| e.live() && !e.processed)
             .count()
     }
@@ -599,7 +568,8 @@ impl<M: Model> Worker<M> {
         &self.samples
     }
 
-    fn route(&mut self, op: Op<M::Msg>) {
+    /// Sends an op on its way; `slot` is its message's record here, when the sender knows it.
+    fn route(&mut self, op: Op<M::Msg>, slot: Option<u32>) {
         let w = self.placement.worker(op.to());
         match &op {
             Op::Msg { .. } => {
@@ -612,31 +582,28 @@ impl<M: Model> Worker<M> {
             Op::Cancel { .. } => {}
         }
         if w == self.index {
-            self.local_ops.push(op);
+            self.local_ops.push((op, slot));
         } else {
             self.outbox[w].push(op);
         }
     }
 
     fn drain_local(&mut self) {
-        while let Some(op) = self.local_ops.pop() {
-            self.apply(op);
+        while let Some((op, slot)) = self.local_ops.pop() {
+            self.apply(op, slot);
         }
     }
 
-    /// Applies one op to its entry, rolling the receiver back if its past changes.
-    fn apply(&mut self, op: Op<M::Msg>) {
+    /// Applies one op to its entry (at `slot` when known), rolling the receiver back if its past
+    /// changes.
+    fn apply(&mut self, op: Op<M::Msg>, slot: Option<u32>) {
         let to = op.to();
         let (uid, time) = match &op {
             Op::Msg { uid, p } => (*uid, p.time.clone()),
             Op::Anti { uid, time, .. } | Op::Cancel { uid, time, .. } => (*uid, time.clone()),
         };
-        let e = self.entries.entry(uid).or_insert(Entry {
-            pos: 0,
-            cancels: SmallVec::new(),
-            p: None,
-            processed: false,
-        });
+        let r = self.entries.open(uid, slot);
+        let e = self.entries.at_mut(r).expect("an open record");
         let before = e.live();
         match op {
             Op::Msg { p, .. } => {
@@ -650,10 +617,10 @@ impl<M: Model> Worker<M> {
             Op::Cancel { sign, at, .. } => e.cancel(at, sign),
         }
         let after = e.live();
-        if e.pos == 0 && e.cancels.is_empty() {
-            self.entries.remove(&uid);
+        if e.empty() {
+            self.entries.remove(r);
         } else if !after {
-            self.graveyard.push((time.t(), uid));
+            self.graveyard.push((time.t(), r));
         }
         if before != after {
             let li = self.placement.local(to);
@@ -661,9 +628,9 @@ impl<M: Model> Worker<M> {
                 self.rollback(li, &time);
             }
             if after {
-                let e = &self.entries[&uid];
+                let e = self.entries.at(r).expect("a live entry is held");
                 let p = e.p.as_ref().expect("a live entry holds its message");
-                self.heap.push(Item::of(uid, p));
+                self.heap.push(Item::of(r, p));
             }
         }
         self.stats.peak_entries = self.stats.peak_entries.max(self.entries.len() as u64);
@@ -682,30 +649,32 @@ impl<M: Model> Worker<M> {
             for s in d.pre_seq + 1..=d.pre_seq + d.sent.len() as u64 {
                 lp.sends.remove(&s);
             }
-            for uid in d.inputs {
-                if let Some(e) = self.entries.get_mut(&uid) {
+            for r in d.inputs {
+                if let Some(e) = self.entries.at_mut(r) {
                     e.processed = false;
                     if e.live() {
                         let p = e.p.as_ref().expect("a live entry holds its message");
-                        self.heap.push(Item::of(uid, p));
+                        self.heap.push(Item::of(r, p));
                     }
                 }
             }
             for (s, _) in d.sent {
-                self.route(Op::Anti {
+                let op = Op::Anti {
                     uid: s.uid,
                     to: s.to,
                     time: s.time,
-                });
+                };
+                self.route(op, s.slot);
             }
             for c in d.cancels {
-                self.route(Op::Cancel {
+                let op = Op::Cancel {
                     uid: c.uid,
                     to: c.to,
                     time: c.time,
                     sign: -1,
                     at: d.time.t(),
-                });
+                };
+                self.route(op, c.slot);
             }
         }
     }
@@ -713,7 +682,7 @@ impl<M: Model> Worker<M> {
     /// Whether a heap item still names a live, unhandled message.
     fn valid(&self, it: &Item) -> bool {
         self.entries
-            .get(&it.uid)
+            .at(it.r)
             .is_some_and(|e| e.live() && !e.processed)
     }
 
@@ -736,20 +705,20 @@ impl<M: Model> Worker<M> {
         }
         let first = self.heap.pop().expect("a valid top");
         let (time, to) = (first.time.clone(), first.to);
-        let mut uids = vec![first.uid];
+        let mut uids = vec![first.r];
         while let Some(top) = self.heap.peek() {
             if top.time != time || top.to != to {
                 break;
             }
             let it = self.heap.pop().expect("a top");
-            if self.valid(&it) && uids.last() != Some(&it.uid) {
-                uids.push(it.uid);
+            if self.valid(&it) && uids.last() != Some(&it.r) {
+                uids.push(it.r);
             }
         }
         let batch: Vec<Envelope<M::Msg>> = uids
             .iter()
-            .map(|u| {
-                let e = self.entries.get_mut(u).expect("a valid entry");
+            .map(|&r| {
+                let e = self.entries.at_mut(r).expect("a valid entry");
                 e.processed = true;
                 e.p.as_ref().expect("a live entry").env.clone()
             })
@@ -770,15 +739,18 @@ impl<M: Model> Worker<M> {
         let mut sent_recs = Vec::with_capacity(sent.len());
         for p in sent {
             let uid = lp.next_uid();
+            let slot =
+                (self.placement.worker(p.to) == self.index).then(|| self.entries.reserve(uid).slot);
             let s = Sent {
                 uid,
+                slot,
                 seq: p.env.seq,
                 to: p.to,
                 time: p.time.clone(),
             };
             lp.sends.insert(p.env.seq, s.clone());
             sent_recs.push((s, model.kind(&p.env.msg) as u16));
-            ops.push(Op::Msg { uid, p });
+            ops.push((Op::Msg { uid, p }, slot));
         }
         let mut cancels = Vec::new();
         for h in &cancelled {
@@ -790,13 +762,14 @@ impl<M: Model> Worker<M> {
             }
         }
         for c in &cancels {
-            ops.push(Op::Cancel {
+            let op = Op::Cancel {
                 uid: c.uid,
                 to: c.to,
                 time: c.time.clone(),
                 sign: 1,
                 at: time.t(),
-            });
+            };
+            ops.push((op, c.slot));
         }
         if !lp.active {
             lp.active = true;
@@ -816,8 +789,8 @@ impl<M: Model> Worker<M> {
         self.uncommitted += 1;
         self.stats.processed += 1;
         self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
-        for op in ops {
-            self.route(op);
+        for (op, slot) in ops {
+            self.route(op, slot);
         }
         self.drain_local();
         true
@@ -847,7 +820,7 @@ impl<M: Model> Worker<M> {
         match &mut self.chaos {
             None => {
                 for op in buf.drain(..) {
-                    self.apply(op);
+                    self.apply(op, None);
                 }
             }
             Some(Chaos { rng, held }) => {
@@ -870,7 +843,7 @@ impl<M: Model> Worker<M> {
                     due.swap(i, j);
                 }
                 for op in due {
-                    self.apply(op);
+                    self.apply(op, None);
                 }
             }
         }
@@ -954,8 +927,8 @@ impl<M: Model> Worker<M> {
                 for (_, kind) in &d.sent {
                     cs.count(usize::from(*kind));
                 }
-                for uid in &d.inputs {
-                    self.entries.remove(uid);
+                for &r in &d.inputs {
+                    self.entries.remove(r);
                 }
                 // a committed cancellation is final: its message needs no name any more
                 for c in &d.cancels {
@@ -983,25 +956,22 @@ impl<M: Model> Worker<M> {
         }
         self.active = still;
         // dead messages whose cancellation is committed can never come back to life
-        let entries = &mut self.entries;
+        let held = &mut self.entries;
         let graveyard = &mut self.graveyard;
-        graveyard.retain(|&(t, uid)| {
+        graveyard.retain(|&(t, r)| {
             // a message cancelled by a committed batch, or any dead message before GVT (nothing
             // for it can be in flight then), is dead for ever
-            let gone = |e: &Entry<M::Msg>| !e.live() && (t < gvt || e.dead_for_good(gvt));
-            if entries.get(&uid).is_some_and(gone) {
-                entries.remove(&uid);
+            let gone = |e: &entries::Entry<M::Msg>| !e.live() && (t < gvt || e.dead_for_good(gvt));
+            if held.at(r).is_some_and(gone) {
+                held.remove(r);
             }
-            t >= gvt && entries.contains_key(&uid)
+            t >= gvt && held.at(r).is_some()
         });
         // heap items of freed messages wait for their time; drop them when they outnumber the rest
         if self.heap.len() > 2 * self.entries.len() + 1024 {
             let entries = &self.entries;
-            self.heap.retain(|it| {
-                entries
-                    .get(&it.uid)
-                    .is_some_and(|e| e.live() && !e.processed)
-            });
+            self.heap
+                .retain(|it| entries.at(it.r).is_some_and(|e| e.live() && !e.processed));
         }
         self.samples
             .push(self.uncommitted as u64 + self.entries.len() as u64);
