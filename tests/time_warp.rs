@@ -151,6 +151,41 @@ fn a_tight_memory_budget_rolls_back_and_stays_exact() {
 }
 
 #[test]
+fn an_instant_commits_as_it_goes() {
+    // at t = 0 every ball sets out and the sectors relay its trajectory: one long instant, which
+    // a GVT of simulation time alone could commit only once it was over
+    let mut s = gas(400, 5);
+    s.until = 1e-9;
+    let sectors = Some(SectorChoice::Grid(8, 8));
+    let want = run(&s, sequential(sectors));
+    let engine = EngineKind::TimeWarp {
+        tw: TwConfig {
+            workers: 2,
+            gvt_interval: 64,
+            ..TwConfig::default()
+        },
+        delay: NvDelay::Exact,
+        sectors,
+    };
+    let got = run(&s, engine);
+    assert_eq!(got.summary["events"]["total"], 0);
+    assert_eq!(
+        got.summary["final_state_digest"],
+        want.summary["final_state_digest"]
+    );
+    let tw = &got.summary["time_warp"];
+    let batches = want.summary["engine_stats"]["batches"].as_f64().unwrap() as u64;
+    assert_eq!(tw["committed"].as_u64(), Some(batches));
+    assert!(tw["gvt_rounds"].as_u64().unwrap() > 4, "{tw}");
+    // each worker holds about one GVT interval of uncommitted batches, not its half of the instant
+    let peak = tw["peak_uncommitted"].as_u64().unwrap();
+    assert!(
+        batches > 500 && peak < batches / 4,
+        "{peak} of {batches}: {tw}"
+    );
+}
+
+#[test]
 fn memory_stays_flat_over_many_gvt_rounds() {
     use poolsim::kernel::time_warp::threads::TimeWarp;
     use poolsim::kernel::VTime;

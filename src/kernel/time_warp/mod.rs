@@ -28,7 +28,8 @@
 //!
 //! GVT (global virtual time) is found in synchronous rounds, as ROSS does: workers stop
 //! processing, drain their inboxes until a reduction says every op sent has been received,
-//! then reduce the smallest simulation time they still hold. Batches before it are committed:
+//! then reduce the first (virtual time, receiver) they still hold a message for, a [`Floor`]:
+//! batches before it are committed, within an instant too:
 //! their output goes, in (virtual time, object) order, to the collector, and their saved states
 //! are freed (fossil collection). The transport and the reductions are a [`Fabric`]: threads
 //! ([`threads`]) or MPI ranks.
@@ -38,8 +39,10 @@ pub mod mpi;
 pub mod threads;
 
 mod entries;
+mod floor;
 
 use entries::{Entries, Ref};
+pub use floor::Floor;
 
 use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime};
 use dary_heap::QuaternaryHeap;
@@ -202,8 +205,8 @@ impl<Msg> Op<Msg> {
 pub struct Reduction {
     /// Ops sent minus ops received (summed).
     pub in_flight: i64,
-    /// The smallest simulation time held (minimum).
-    pub min_t: f64,
+    /// The first batch that may still change (minimum).
+    pub floor: Floor,
     /// Workers asked to stop (summed).
     pub stop: u64,
 }
@@ -213,7 +216,7 @@ impl Reduction {
     pub fn combine(self, o: Reduction) -> Reduction {
         Reduction {
             in_flight: self.in_flight + o.in_flight,
-            min_t: self.min_t.min(o.min_t),
+            floor: self.floor.min(o.floor),
             stop: self.stop + o.stop,
         }
     }
@@ -425,7 +428,7 @@ pub struct Worker<M: Model> {
     sent_ops: i64,
     received_ops: i64,
     uncommitted: usize,
-    gvt: f64,
+    gvt: Floor,
     /// The optimism window when none is set: a few GVT rounds' worth of progress.
     auto_window: f64,
     round: u64,
@@ -488,7 +491,7 @@ impl<M: Model> Worker<M> {
             sent_ops: 0,
             received_ops: 0,
             uncommitted: 0,
-            gvt: f64::NEG_INFINITY,
+            gvt: Floor::NEG_INFINITY,
             auto_window: f64::INFINITY,
             round: 0,
             stats: TwStats {
@@ -800,7 +803,7 @@ impl<M: Model> Worker<M> {
     /// that message is later than GVT's instant.
     fn artificial_rollback(&mut self) {
         // batches of GVT's own instant cannot be committed yet: they are needed, not optimism
-        if self.next_time().is_none_or(|t| t <= self.gvt) {
+        if self.next_time().is_none_or(|t| t <= self.gvt.t) {
             return;
         }
         let t = self.heap.peek().expect("a valid top").time.clone();
@@ -857,31 +860,37 @@ impl<M: Model> Worker<M> {
         }
     }
 
-    /// The smallest time this worker still holds: unhandled messages and held ops.
-    fn local_min(&mut self) -> f64 {
-        let mut m = self.next_time().unwrap_or(f64::INFINITY);
+    /// The first batch this worker's unhandled messages and held ops may still change.
+    fn local_min(&mut self) -> Floor {
+        let mut m = match self.next_time() {
+            Some(_) => {
+                let top = self.heap.peek().expect("a valid top");
+                Floor::of(&top.time, top.to)
+            }
+            None => Floor::INFINITY,
+        };
         if let Some(c) = &self.chaos {
             for (_, op) in &c.held {
-                m = m.min(op.time().t());
+                m = m.min(Floor::of(op.time(), op.to()));
                 // a held cancellation keeps GVT below its batch, so that fossil collection
                 // cannot take the message it counts on for cancelled for good
                 if let Op::Cancel { at, .. } = op {
-                    m = m.min(*at);
+                    m = m.min(Floor::start(*at));
                 }
             }
         }
         m
     }
 
-    /// A GVT round: returns GVT (a simulation time; every batch before it is final).
-    fn gvt_round<F: Fabric<M>>(&mut self, fabric: &F, stop: bool) -> Result<f64, Stop> {
+    /// A GVT round: returns GVT (every batch before it is final).
+    fn gvt_round<F: Fabric<M>>(&mut self, fabric: &F, stop: bool) -> Result<Floor, Stop> {
         let mut buf = Vec::new();
         loop {
             self.receive(fabric, &mut buf);
             self.flush(fabric);
             let local = Reduction {
                 in_flight: self.sent_ops - self.received_ops,
-                min_t: self.local_min(),
+                floor: self.local_min(),
                 stop: u64::from(stop),
             };
             let g = fabric.reduce(self.index, local);
@@ -890,7 +899,7 @@ impl<M: Model> Worker<M> {
             }
             if g.in_flight == 0 {
                 self.stats.gvt_rounds += 1;
-                return Ok(g.min_t);
+                return Ok(g.floor);
             }
         }
     }
@@ -900,7 +909,7 @@ impl<M: Model> Worker<M> {
     fn fossil_collect(
         &mut self,
         model: &M,
-        gvt: f64,
+        gvt: Floor,
         ship: bool,
     ) -> Vec<Committed<M::State, M::Output>> {
         let mut out = Vec::new();
@@ -908,7 +917,11 @@ impl<M: Model> Worker<M> {
         for &li in &self.active {
             let lp = &mut self.lps[li as usize];
             let observed = ship && model.observed(lp.id);
-            while lp.history.front().is_some_and(|d| d.time.t() < gvt) {
+            while lp
+                .history
+                .front()
+                .is_some_and(|d| gvt.passed(&d.time, lp.id))
+            {
                 let d = lp.history.pop_front().expect("a batch to commit");
                 if let Some(what) = d.into_past {
                     self.fault
@@ -945,7 +958,7 @@ impl<M: Model> Worker<M> {
                 }
             }
             if lp.sends.len() > lp.sweep_at {
-                lp.sends.retain(|_, s| s.time.t() >= gvt);
+                lp.sends.retain(|_, s| !gvt.passed(&s.time, s.to));
                 lp.sweep_at = 2 * lp.sends.len().max(32);
             }
             if lp.history.is_empty() {
@@ -955,7 +968,9 @@ impl<M: Model> Worker<M> {
             }
         }
         self.active = still;
-        // dead messages whose cancellation is committed can never come back to life
+        // dead messages whose cancellation is committed can never come back to life (judged by
+        // simulation time: cancellations are kept by the time of their batch)
+        let gvt = gvt.t;
         let held = &mut self.entries;
         let graveyard = &mut self.graveyard;
         graveyard.retain(|&(t, r)| {
@@ -995,7 +1010,7 @@ impl<M: Model> Worker<M> {
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
-            let window = self.gvt + cfg.window.unwrap_or(self.auto_window);
+            let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window);
             let mut limit = until.min(window);
             let burst = match &mut self.chaos {
                 Some(c) => c.rng.gen_range(1..64u32),
@@ -1008,7 +1023,7 @@ impl<M: Model> Worker<M> {
                         break;
                     }
                     self.artificial_rollback();
-                    limit = limit.min(self.gvt);
+                    limit = limit.min(self.gvt.t);
                 }
                 if !self.step(model, limit) {
                     break;
@@ -1046,8 +1061,8 @@ impl<M: Model> Worker<M> {
                 Err(s) => break Err(s),
                 Ok(gvt) => {
                     // without a set window, run at most a few rounds' worth of GVT progress ahead
-                    if self.gvt.is_finite() && gvt.is_finite() && gvt > self.gvt {
-                        self.auto_window = 4.0 * (gvt - self.gvt);
+                    if self.gvt.t.is_finite() && gvt.t.is_finite() && gvt.t > self.gvt.t {
+                        self.auto_window = 4.0 * (gvt.t - self.gvt.t);
                     }
                     self.gvt = gvt;
                     let batches = self.fossil_collect(model, gvt, ship);
@@ -1060,7 +1075,7 @@ impl<M: Model> Worker<M> {
                         finals: Vec::new(),
                         error: None,
                     });
-                    if gvt > until {
+                    if gvt.t > until {
                         break Ok(());
                     }
                 }

@@ -14,7 +14,7 @@
 //! (MPI is initialized with `Threading::Serialized`); no other network layer is involved.
 
 use super::threads::ThreadReduce;
-use super::{Chunk, Fabric, Op, Reduction};
+use super::{Chunk, Fabric, Floor, Op, Reduction};
 use crate::kernel::Model;
 use mpi::collective::SystemOperation;
 use mpi::datatype::{Partition, PartitionMut};
@@ -23,6 +23,17 @@ use mpi::traits::*;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::sync::{mpsc, Barrier, Mutex};
+
+/// The smallest of every rank's floor: each rank's words gathered, the minimum taken alike on
+/// every rank.
+fn all_min(world: &SimpleCommunicator, here: Floor) -> Floor {
+    let words = here.to_words();
+    let mut all = vec![0u64; words.len() * world.size() as usize];
+    world.all_gather_into(&words[..], &mut all[..]);
+    all.chunks(words.len())
+        .map(Floor::from_words)
+        .fold(Floor::INFINITY, Floor::min)
+}
 
 /// This process's place among the MPI ranks: `(rank, ranks)`, or `(0, 1)` when MPI is not
 /// initialized.
@@ -189,7 +200,7 @@ where
             let world = SimpleCommunicator::world();
             let mut g = here;
             world.all_reduce_into(&here.in_flight, &mut g.in_flight, SystemOperation::sum());
-            world.all_reduce_into(&here.min_t, &mut g.min_t, SystemOperation::min());
+            g.floor = all_min(&world, here.floor);
             world.all_reduce_into(&here.stop, &mut g.stop, SystemOperation::sum());
             *self.result.lock().expect("no thread panicked") = g;
         }

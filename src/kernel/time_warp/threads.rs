@@ -2,7 +2,7 @@
 //! the executor that runs one thread per worker while the calling thread collects committed
 //! batches and feeds them, in order, to the sink.
 
-use super::{Chunk, Committed, Fabric, Op, Placement, Reduction, TwConfig, TwStats, Worker};
+use super::{Chunk, Committed, Fabric, Floor, Op, Placement, Reduction, TwConfig, TwStats, Worker};
 use crate::kernel::sequential::Sink;
 use crate::kernel::{MessageStats, Model, VTime};
 use std::collections::BTreeMap;
@@ -12,7 +12,7 @@ use std::sync::{mpsc, Arc, Barrier, Mutex};
 /// The identity of [`Reduction::combine`].
 pub const NOTHING: Reduction = Reduction {
     in_flight: 0,
-    min_t: f64::INFINITY,
+    floor: Floor::INFINITY,
     stop: 0,
 };
 

@@ -1,0 +1,205 @@
+//! GVT as a place in the order of batches, not only a simulation time.
+//!
+//! Batches run in the order (virtual time, receiver). A GVT that is only a simulation time can
+//! commit nothing of the instant it stands in, and an instant can be long: at t = 0 every ball of
+//! a sectored gas sets out and its trajectory is relayed through the sectors, some hundred
+//! thousand batches at 10^5 balls, which would all wait uncommitted (with their saved states and
+//! messages) until the instant ended. A [`Floor`] is the smallest (virtual time, receiver) of any
+//! message still to be handled: every later send goes strictly forward in virtual time, so no
+//! batch before the floor can change any more, whatever its time.
+//!
+//! It has a fixed size so that reductions carry it as plain words (threads, and MPI as eight
+//! 64-bit integers): a key deeper than [`DEPTH`] pairs is cut to its first pairs, which sorts
+//! before the whole key, so the cut only makes GVT more cautious.
+
+use super::super::VTime;
+use crate::vtime::Key;
+use smallvec::SmallVec;
+use std::cmp::Ordering;
+
+/// The pairs of a key's path a floor keeps.
+pub const DEPTH: usize = 4;
+
+/// A lower bound on the (virtual time, receiver) of every batch that may still change.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Floor {
+    /// Simulation time.
+    pub t: f64,
+    path: [u64; DEPTH],
+    len: u8,
+    gen: u32,
+    to: u32,
+}
+
+impl Floor {
+    /// Above every batch: nothing is left to run.
+    pub const INFINITY: Floor = Floor::start(f64::INFINITY);
+    /// Below every batch: nothing is known yet.
+    pub const NEG_INFINITY: Floor = Floor::start(f64::NEG_INFINITY);
+
+    /// The start of the instant `t`: before every batch at `t`.
+    pub const fn start(t: f64) -> Floor {
+        Floor {
+            t,
+            path: [0; DEPTH],
+            len: 0,
+            gen: 0,
+            to: 0,
+        }
+    }
+
+    /// The place of the batch of object `to` at `time`, or just before it when its key is
+    /// deeper than [`DEPTH`].
+    pub fn of(time: &VTime, to: u32) -> Floor {
+        let path = time.key.path.as_slice();
+        let mut f = Floor::start(time.key.t);
+        let kept = path.len().min(DEPTH);
+        f.path[..kept].copy_from_slice(&path[..kept]);
+        f.len = kept as u8;
+        if kept == path.len() {
+            f.gen = time.gen;
+            f.to = to;
+        }
+        f
+    }
+
+    /// Whether the batch of object `to` at `time` comes before this floor (and is final).
+    pub fn passed(&self, time: &VTime, to: u32) -> bool {
+        time.key
+            .t
+            .total_cmp(&self.t)
+            .then_with(|| {
+                time.key
+                    .path
+                    .as_slice()
+                    .cmp(&self.path[..usize::from(self.len)])
+            })
+            .then(time.gen.cmp(&self.gen))
+            .then(to.cmp(&self.to))
+            .is_lt()
+    }
+
+    /// The smaller of two floors.
+    pub fn min(self, o: Floor) -> Floor {
+        if o < self {
+            o
+        } else {
+            self
+        }
+    }
+
+    /// The floor as words, for a reduction over MPI.
+    pub fn to_words(&self) -> [u64; DEPTH + 3] {
+        let mut w = [0u64; DEPTH + 3];
+        w[0] = self.t.to_bits();
+        w[1..=DEPTH].copy_from_slice(&self.path);
+        w[DEPTH + 1] = u64::from(self.len);
+        w[DEPTH + 2] = (u64::from(self.gen) << 32) | u64::from(self.to);
+        w
+    }
+
+    /// The floor [`Floor::to_words`] wrote.
+    pub fn from_words(w: &[u64]) -> Floor {
+        let mut path = [0u64; DEPTH];
+        path.copy_from_slice(&w[1..=DEPTH]);
+        Floor {
+            t: f64::from_bits(w[0]),
+            path,
+            len: (w[DEPTH + 1] as u8).min(DEPTH as u8),
+            gen: (w[DEPTH + 2] >> 32) as u32,
+            to: w[DEPTH + 2] as u32,
+        }
+    }
+
+    /// The virtual time of the floor (without its receiver).
+    pub fn time(&self) -> VTime {
+        VTime {
+            key: Key {
+                t: self.t,
+                path: SmallVec::from_slice(&self.path[..usize::from(self.len)]),
+            },
+            gen: self.gen,
+        }
+    }
+}
+
+impl PartialOrd for Floor {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(
+            self.t
+                .total_cmp(&o.t)
+                .then_with(|| self.path[..usize::from(self.len)].cmp(&o.path[..usize::from(o.len)]))
+                .then(self.gen.cmp(&o.gen))
+                .then(self.to.cmp(&o.to)),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vtime::pair;
+    use proptest::prelude::*;
+
+    fn vtime(t: f64, path: &[u64], gen: u32) -> VTime {
+        VTime {
+            key: Key {
+                t,
+                path: SmallVec::from_slice(path),
+            },
+            gen,
+        }
+    }
+
+    #[test]
+    fn batches_of_an_instant_pass_one_by_one() {
+        let k = vtime(0.0, &[], 2);
+        let f = Floor::of(&k, 7);
+        assert!(f.passed(&k, 6));
+        assert!(!f.passed(&k, 7));
+        assert!(f.passed(&vtime(0.0, &[], 1), 9));
+        assert!(!f.passed(&vtime(0.0, &[pair(1, 2)], 0), 0));
+        assert!(Floor::start(0.0).passed(&vtime(-1.0, &[], 0), 5));
+        assert!(!Floor::start(0.0).passed(&vtime(0.0, &[], 0), 0));
+        assert!(Floor::INFINITY.passed(&vtime(1e300, &[], 0), 0));
+        assert!(!Floor::NEG_INFINITY.passed(&vtime(-1e300, &[], 0), 0));
+    }
+
+    #[test]
+    fn deep_keys_are_cut_to_a_floor_below_them() {
+        let path: Vec<u64> = (1..=6).map(|k| pair(k, k + 1)).collect();
+        let deep = vtime(3.0, &path, 5);
+        let f = Floor::of(&deep, 9);
+        assert!(!f.passed(&deep, 9));
+        assert!(!f.passed(&deep, 0));
+        let mut deeper = path.clone();
+        deeper.push(pair(8, 9));
+        let shallow = vtime(3.0, &path[..DEPTH], 5);
+        let g = Floor::of(&shallow, 9);
+        assert!(!g.passed(&vtime(3.0, &deeper, 0), 0));
+        assert_eq!(f.time().key.path.as_slice(), &path[..DEPTH]);
+        assert!(f.time() < deep);
+    }
+
+    fn arb_vtime() -> impl Strategy<Value = VTime> {
+        (-2i32..3, prop::collection::vec(0u64..4, 0..7), 0u32..3)
+            .prop_map(|(t, path, gen)| vtime(f64::from(t), &path, gen))
+    }
+
+    proptest! {
+        /// A floor never passes a batch that is not before the batch it was taken from, and
+        /// passes every batch before it when its key is short enough to be kept whole.
+        #[test]
+        fn floors_order_like_batches(a in arb_vtime(), ta in 0u32..3, b in arb_vtime(), tb in 0u32..3) {
+            let f = Floor::of(&a, ta);
+            let before = (&b, tb) < (&a, ta);
+            if f.passed(&b, tb) {
+                prop_assert!(before);
+            }
+            if a.key.path.len() <= DEPTH && b.key.path.len() <= DEPTH {
+                prop_assert_eq!(f.passed(&b, tb), before);
+            }
+            prop_assert_eq!(Floor::from_words(&f.to_words()), f);
+        }
+    }
+}
