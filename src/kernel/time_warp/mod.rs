@@ -349,7 +349,9 @@ struct Lp<M: Model> {
     seq: u64,
     uids: u64,
     history: VecDeque<Done<M>>,
-    /// Messages it sent that may still be cancelled, by send sequence.
+    /// Messages its committed batches sent that may still be cancelled, by send sequence
+    /// (an uncommitted batch keeps its own in `history`: most are delivered before it commits,
+    /// and never need filing).
     sends: FxHashMap<u64, Sent>,
     /// Size of `sends` past which fossil collection sweeps it (amortized: doubled each sweep).
     sweep_at: usize,
@@ -360,6 +362,19 @@ struct Lp<M: Model> {
 impl<M: Model> Lp<M> {
     fn last_time(&self) -> Option<&VTime> {
         self.history.back().map(|d| &d.time)
+    }
+
+    /// The message it sent with sequence `seq`, if it may still be cancelled.
+    fn sent(&self, seq: u64) -> Option<&Sent> {
+        // batches in history are in send order: the last one that began before `seq` sent it
+        let k = self.history.partition_point(|d| d.pre_seq < seq);
+        if k == 0 {
+            return self.sends.get(&seq);
+        }
+        let sent = &self.history[k - 1].sent;
+        sent.binary_search_by_key(&seq, |(s, _)| s.seq)
+            .ok()
+            .map(|i| &sent[i].0)
     }
 
     fn next_uid(&mut self) -> u64 {
@@ -649,9 +664,6 @@ impl<M: Model> Worker<M> {
             self.stats.rolled_back += 1;
             lp.state = d.pre_state;
             lp.seq = d.pre_seq;
-            for s in d.pre_seq + 1..=d.pre_seq + d.sent.len() as u64 {
-                lp.sends.remove(&s);
-            }
             for r in d.inputs {
                 if let Some(e) = self.entries.at_mut(r) {
                     e.processed = false;
@@ -751,13 +763,17 @@ impl<M: Model> Worker<M> {
                 to: p.to,
                 time: p.time.clone(),
             };
-            lp.sends.insert(p.env.seq, s.clone());
             sent_recs.push((s, model.kind(&p.env.msg) as u16));
             ops.push((Op::Msg { uid, p }, slot));
         }
         let mut cancels = Vec::new();
         for h in &cancelled {
-            if let Some(s) = lp.sends.get(&h.seq) {
+            let this_batch = sent_recs.binary_search_by_key(&h.seq, |(s, _)| s.seq);
+            let s = match this_batch {
+                Ok(i) => Some(&sent_recs[i].0),
+                Err(_) => lp.sent(h.seq),
+            };
+            if let Some(s) = s {
                 // after this batch in the sequential order: not delivered yet
                 if (&s.time, s.to) > (&time, to) {
                     cancels.push(s.clone());
@@ -937,8 +953,12 @@ impl<M: Model> Worker<M> {
                 cs.batches += 1;
                 cs.delivered += d.inputs.len() as u64;
                 cs.cancels += u64::from(d.cancel_calls);
-                for (_, kind) in &d.sent {
-                    cs.count(usize::from(*kind));
+                for (s, kind) in d.sent {
+                    cs.count(usize::from(kind));
+                    // still ahead: it may yet be cancelled by a later batch
+                    if !gvt.passed(&s.time, s.to) {
+                        lp.sends.insert(s.seq, s);
+                    }
                 }
                 for &r in &d.inputs {
                     self.entries.remove(r);
