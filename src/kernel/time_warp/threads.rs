@@ -127,6 +127,11 @@ pub struct Collector<M: Model> {
     shipped: bool,
     rounds: BTreeMap<u64, Vec<ChunkOf<M>>>,
     next_round: u64,
+    /// Workers' final states, held until every round before them has gone to the sink: a
+    /// worker's last chunk can arrive before another worker's chunk of their last round.
+    finals: Vec<(u32, M::State)>,
+    /// Workers whose last chunk of this run has arrived.
+    lasts: usize,
     /// Statistics of the workers' last chunks.
     pub stats: TwStats,
     /// Committed message statistics (summed over runs).
@@ -143,6 +148,8 @@ impl<M: Model> Collector<M> {
             shipped: true,
             rounds: BTreeMap::new(),
             next_round: 1,
+            finals: Vec::new(),
+            lasts: 0,
             stats: TwStats::default(),
             messages: MessageStats::default(),
             pending: 0,
@@ -163,12 +170,12 @@ impl<M: Model> Collector<M> {
             self.stats.add(stats);
             self.messages.add(messages);
             self.pending += pending;
-            for (id, state) in chunk.finals {
-                self.states[id as usize] = state;
-            }
+            self.finals.extend(chunk.finals);
+            self.lasts += 1;
             if let (Some(e), None) = (&chunk.error, &failed) {
                 *failed = Some(TwError::Failed(e.clone()));
             }
+            self.settle(workers);
             return;
         }
         self.rounds.entry(chunk.round).or_default().push(chunk);
@@ -211,6 +218,16 @@ impl<M: Model> Collector<M> {
                 if failed.is_some() {
                     break;
                 }
+            }
+        }
+        self.settle(workers);
+    }
+
+    /// Takes the final states once every worker has sent them and every round is through.
+    fn settle(&mut self, workers: usize) {
+        if self.lasts == workers && self.rounds.is_empty() {
+            for (id, state) in self.finals.drain(..) {
+                self.states[id as usize] = state;
             }
         }
     }
@@ -349,6 +366,7 @@ where
         let mut failed: Option<TwError<E>> = None;
         self.collector.stats = TwStats::default();
         self.collector.pending = 0;
+        self.collector.lasts = 0;
         if self.ranks == 1 {
             let fabric = ThreadFabric::<M>::new(self.workers.len(), tx);
             self.drive(&fabric, &rx, until, sink, &mut failed);
@@ -424,5 +442,92 @@ where
         for chunk in rx.try_iter() {
             collector.take(model, total, chunk, sink, failed);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::{Ctx, Envelope};
+    use crate::vtime::Key;
+
+    /// Objects whose state is a number; nothing is ever sent.
+    struct Numbers;
+
+    impl Model for Numbers {
+        type Msg = ();
+        type State = u32;
+        type Output = ();
+
+        fn kind_names(&self) -> &'static [&'static str] {
+            &["Nothing"]
+        }
+        fn kind(&self, _: &()) -> usize {
+            0
+        }
+        fn priority(&self, _: &()) -> u8 {
+            0
+        }
+        fn init(&self, _: &mut Ctx<'_, Self>, _: u32, _: &mut u32) {}
+        fn handle(&self, _: &mut Ctx<'_, Self>, _: u32, _: &mut u32, _: &[Envelope<()>]) {}
+    }
+
+    fn chunk(worker: usize, round: u64, batches: Vec<Committed<u32, ()>>) -> Chunk<u32, ()> {
+        Chunk {
+            worker,
+            round,
+            batches,
+            last: None,
+            finals: Vec::new(),
+            error: None,
+        }
+    }
+
+    #[test]
+    fn final_states_wait_for_the_last_round() {
+        let mut c: Collector<Numbers> = Collector::new(vec![0, 0]);
+        let mut seen = Vec::new();
+        let mut failed = None;
+        let mut sink = |_: &Numbers, states: &[u32], (): ()| {
+            seen.push(states.to_vec());
+            Ok::<(), ()>(())
+        };
+        let at = |obj, state: u32, output| Committed {
+            time: VTime::at(Key::start(1.0)),
+            obj,
+            state: Some(state),
+            output,
+        };
+        // worker 0 commits object 0's batch in round 1 and finishes (object 0 ends at 9) before
+        // worker 1's chunk of round 1, whose batch of object 1 reports an output, arrives
+        c.take(
+            &Numbers,
+            2,
+            chunk(0, 1, vec![at(0, 5, vec![])]),
+            &mut sink,
+            &mut failed,
+        );
+        let mut last = chunk(0, u64::MAX, Vec::new());
+        last.last = Some((TwStats::default(), MessageStats::default(), 0));
+        last.finals = vec![(0, 9)];
+        c.take(&Numbers, 2, last, &mut sink, &mut failed);
+        c.take(
+            &Numbers,
+            2,
+            chunk(1, 1, vec![at(1, 7, vec![()])]),
+            &mut sink,
+            &mut failed,
+        );
+        let mut last = chunk(1, u64::MAX, Vec::new());
+        last.last = Some((TwStats::default(), MessageStats::default(), 0));
+        last.finals = vec![(1, 8)];
+        c.take(&Numbers, 2, last, &mut sink, &mut failed);
+        assert!(failed.is_none());
+        assert_eq!(
+            seen,
+            vec![vec![5, 7]],
+            "the output saw the states of its round"
+        );
+        assert_eq!(c.states(), &[9, 8], "and the final states came after it");
     }
 }
