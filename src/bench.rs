@@ -1,6 +1,7 @@
 //! `poolsim bench`: physical events per second and nanoseconds per event of the event-list engine
 //! on the thesis gas, over ball counts and area fractions, with the machine's description; then
-//! the objects engine's cost over ball counts, and PHOLD's committed events per second.
+//! the objects engine's cost over ball counts, Time Warp against the sequential objects engine
+//! on the sectored gas, and PHOLD's committed events per second.
 //!
 //! Setup (generating the gas and predicting every ball's first event) is timed apart from the
 //! event loop, so the figures are the steady cost of an event. Each configuration runs a fixed
@@ -46,6 +47,13 @@ pub struct BenchArgs {
         default_value = "1024,4096"
     )]
     pub sectored_balls: Vec<usize>,
+    /// Ball counts for Time Warp on 1 and 2 workers against the sequential objects engine: whole
+    /// runs of the sectored gas (`--sectors auto`) until `--tw-until`, set-up included.
+    #[arg(long = "tw-balls", value_delimiter = ',', default_value = "9801")]
+    pub tw_balls: Vec<usize>,
+    /// Simulated time of the Time Warp runs.
+    #[arg(long = "tw-until", default_value_t = 1.0)]
+    pub tw_until: f64,
     /// PHOLD objects (16 messages each, remote 0.1, 2 partitions, lookahead 0.1).
     #[arg(long = "phold-objects", default_value_t = 1024)]
     pub phold_objects: u32,
@@ -205,6 +213,12 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             ));
         }
     }
+    if !(a.tw_until.is_finite() && a.tw_until > 0.0) {
+        return Err(format!(
+            "--tw-until: must be a positive simulated time, got {}",
+            a.tw_until
+        ));
+    }
     let m = machine();
     if !a.json {
         println!("event-list engine, thesis gas (seed 1), one thread; {m}");
@@ -270,6 +284,40 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         }
         sectored.push(r);
     }
+    if !a.json {
+        println!();
+        println!(
+            "Time Warp against the sequential objects engine: sectored gas (--sectors auto) \
+             until {}, whole runs",
+            a.tw_until
+        );
+        println!(
+            "{:>9} {:>8} {:>9} {:>9} {:>11} {:>8}  digest",
+            "balls", "workers", "wall s", "speed-up", "efficiency", "remote"
+        );
+    }
+    let mut time_warp = Vec::new();
+    for &n in &a.tw_balls {
+        for r in measure_time_warp(n, a.tw_until)? {
+            if !a.json {
+                println!(
+                    "{:>9} {:>8} {:>9.3} {:>9.2} {:>11.3} {:>8.3}  {}",
+                    r.balls,
+                    if r.workers == 0 {
+                        "seq".to_string()
+                    } else {
+                        r.workers.to_string()
+                    },
+                    r.seconds,
+                    r.speedup,
+                    r.efficiency,
+                    r.remote_fraction,
+                    r.digest
+                );
+            }
+            time_warp.push(r);
+        }
+    }
     // PHOLD: the sequential kernel, then Time Warp on 1 and 2 workers (2 partitions each)
     let phold_cfg = crate::model::phold::PholdConfig {
         objects: a.phold_objects,
@@ -292,7 +340,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         println!(
             "{}",
             json!({"machine": m, "engine": "event-list", "rows": rows, "growth": growth,
-                   "objects": objects, "sectored": sectored, "phold": phold})
+                   "objects": objects, "sectored": sectored, "time_warp": time_warp,
+                   "phold": phold})
         );
     } else {
         println!();
@@ -412,6 +461,95 @@ pub fn measure_objects(
     })
 }
 
+/// One whole run of the sectored gas for `poolsim bench`'s Time Warp table.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TwRow {
+    /// Balls.
+    pub balls: usize,
+    /// Simulated time run.
+    pub until: f64,
+    /// Time Warp workers (0: the sequential objects engine).
+    pub workers: usize,
+    /// Wall seconds, set-up included.
+    pub seconds: f64,
+    /// The sequential run's seconds over this run's.
+    pub speedup: f64,
+    /// Physical events.
+    pub events: u64,
+    /// Committed over processed batches (1 for the sequential engine).
+    pub efficiency: f64,
+    /// Messages that crossed workers over all messages.
+    pub remote_fraction: f64,
+    /// The final state digest (the same for every executor, or the bench fails).
+    pub digest: String,
+}
+
+/// Runs the sectored gas (`--sectors auto`) of `balls` balls until `until` on the sequential
+/// objects engine and under Time Warp on 1 and 2 workers; fails if any digest differs.
+pub fn measure_time_warp(balls: usize, until: f64) -> Result<Vec<TwRow>, String> {
+    use crate::run::{execute, EngineKind, RunConfig, SectorChoice};
+    let k = ((balls as f64).sqrt().round() as usize).max(1);
+    let params = Params {
+        balls: Some(k * k),
+        seed: Some(1),
+        ..Params::default()
+    };
+    let scenario =
+        builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
+    let mut rows: Vec<TwRow> = Vec::new();
+    for workers in [0, 1, 2] {
+        let engine = match workers {
+            0 => EngineKind::Sectored {
+                sectors: SectorChoice::Auto,
+            },
+            w => EngineKind::TimeWarp {
+                tw: crate::kernel::time_warp::TwConfig {
+                    workers: w,
+                    ..Default::default()
+                },
+                delay: crate::model::pool::NvDelay::Exact,
+                sectors: Some(SectorChoice::Auto),
+            },
+        };
+        let cfg = RunConfig {
+            engine,
+            until,
+            check: false,
+            span: Default::default(),
+        };
+        let report = execute(&scenario, &cfg, &mut Ignore).map_err(|e| e.to_string())?;
+        let s = &report.summary;
+        let tw = &s["time_warp"];
+        let digest = s["final_state_digest"]
+            .as_str()
+            .unwrap_or_default()
+            .to_string();
+        if let Some(first) = rows.first() {
+            if first.digest != digest {
+                return Err(format!(
+                    "bench: Time Warp on {workers} workers ended in state {digest}, the \
+                     sequential engine in {} ({} balls until {until})",
+                    first.digest,
+                    k * k
+                ));
+            }
+        }
+        let seconds = report.wall_seconds;
+        rows.push(TwRow {
+            balls: k * k,
+            until,
+            workers,
+            seconds,
+            speedup: rows.first().map_or(1.0, |r| r.seconds / seconds),
+            events: report.outcome.events.total(),
+            efficiency: tw["efficiency"].as_f64().unwrap_or(1.0),
+            remote_fraction: tw["remote_fraction"].as_f64().unwrap_or(0.0),
+            digest,
+        });
+    }
+    Ok(rows)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -427,6 +565,23 @@ mod tests {
             ns_per_event,
             rss_mib: 0.0,
         }
+    }
+
+    #[test]
+    fn time_warp_rows_agree_with_the_sequential_run() {
+        let rows = measure_time_warp(100, 0.5).unwrap();
+        assert_eq!(
+            rows.iter().map(|r| r.workers).collect::<Vec<_>>(),
+            [0, 1, 2]
+        );
+        assert!(rows
+            .iter()
+            .all(|r| r.digest == rows[0].digest && r.balls == 100));
+        assert!(rows
+            .iter()
+            .all(|r| r.events == rows[0].events && r.events > 0));
+        assert_eq!(rows[0].speedup, 1.0);
+        assert_eq!(rows[1].efficiency, 1.0);
     }
 
     #[test]
