@@ -367,6 +367,7 @@ where
         self.collector.stats = TwStats::default();
         self.collector.pending = 0;
         self.collector.lasts = 0;
+        self.collector.finals.clear();
         if self.ranks == 1 {
             let fabric = ThreadFabric::<M>::new(self.workers.len(), tx);
             self.drive(&fabric, &rx, until, sink, &mut failed);
