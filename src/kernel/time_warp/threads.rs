@@ -484,6 +484,15 @@ mod tests {
         }
     }
 
+    /// A worker's last chunk of a run, with its objects' final states.
+    fn last_chunk(worker: usize, finals: Vec<(u32, u32)>) -> Chunk<u32, ()> {
+        Chunk {
+            last: Some((TwStats::default(), MessageStats::default(), 0)),
+            finals,
+            ..chunk(worker, u64::MAX, Vec::new())
+        }
+    }
+
     #[test]
     fn final_states_wait_for_the_last_round() {
         let mut c: Collector<Numbers> = Collector::new(vec![0, 0]);
@@ -508,10 +517,13 @@ mod tests {
             &mut sink,
             &mut failed,
         );
-        let mut last = chunk(0, u64::MAX, Vec::new());
-        last.last = Some((TwStats::default(), MessageStats::default(), 0));
-        last.finals = vec![(0, 9)];
-        c.take(&Numbers, 2, last, &mut sink, &mut failed);
+        c.take(
+            &Numbers,
+            2,
+            last_chunk(0, vec![(0, 9)]),
+            &mut sink,
+            &mut failed,
+        );
         c.take(
             &Numbers,
             2,
@@ -519,10 +531,13 @@ mod tests {
             &mut sink,
             &mut failed,
         );
-        let mut last = chunk(1, u64::MAX, Vec::new());
-        last.last = Some((TwStats::default(), MessageStats::default(), 0));
-        last.finals = vec![(1, 8)];
-        c.take(&Numbers, 2, last, &mut sink, &mut failed);
+        c.take(
+            &Numbers,
+            2,
+            last_chunk(1, vec![(1, 8)]),
+            &mut sink,
+            &mut failed,
+        );
         assert!(failed.is_none());
         assert_eq!(
             seen,
