@@ -8,13 +8,11 @@
 //! message still to be handled: every later send goes strictly forward in virtual time, so no
 //! batch before the floor can change any more, whatever its time.
 //!
-//! It has a fixed size so that reductions carry it as plain words (threads, and MPI as eight
+//! It has a fixed size so that reductions carry it as plain words (threads, and MPI as seven
 //! 64-bit integers): a key deeper than [`DEPTH`] pairs is cut to its first pairs, which sorts
 //! before the whole key, so the cut only makes GVT more cautious.
 
 use super::super::VTime;
-use crate::vtime::Key;
-use smallvec::SmallVec;
 use std::cmp::Ordering;
 
 /// The pairs of a key's path a floor keeps.
@@ -110,17 +108,6 @@ impl Floor {
             to: w[DEPTH + 2] as u32,
         }
     }
-
-    /// The virtual time of the floor (without its receiver).
-    pub fn time(&self) -> VTime {
-        VTime {
-            key: Key {
-                t: self.t,
-                path: SmallVec::from_slice(&self.path[..usize::from(self.len)]),
-            },
-            gen: self.gen,
-        }
-    }
 }
 
 impl PartialOrd for Floor {
@@ -138,8 +125,9 @@ impl PartialOrd for Floor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vtime::pair;
+    use crate::vtime::{pair, Key};
     use proptest::prelude::*;
+    use smallvec::SmallVec;
 
     fn vtime(t: f64, path: &[u64], gen: u32) -> VTime {
         VTime {
@@ -177,8 +165,8 @@ mod tests {
         let shallow = vtime(3.0, &path[..DEPTH], 5);
         let g = Floor::of(&shallow, 9);
         assert!(!g.passed(&vtime(3.0, &deeper, 0), 0));
-        assert_eq!(f.time().key.path.as_slice(), &path[..DEPTH]);
-        assert!(f.time() < deep);
+        assert_eq!(&f.path[..usize::from(f.len)], &path[..DEPTH]);
+        assert!(f.passed(&vtime(3.0, &path[..DEPTH - 1], 9), 9));
     }
 
     fn arb_vtime() -> impl Strategy<Value = VTime> {
