@@ -182,6 +182,24 @@ fn proc_status_mib(field: &str) -> f64 {
         .map_or(0.0, |kb| kb / 1024.0)
 }
 
+/// The thesis gas (seed 1) with `balls` rounded to a square number, at `area_fraction` where
+/// given; returns the ball count with it.
+fn thesis_gas(
+    balls: usize,
+    area_fraction: Option<f64>,
+) -> Result<(usize, crate::scenario::Scenario), String> {
+    let k = ((balls as f64).sqrt().round() as usize).max(1);
+    let params = Params {
+        balls: Some(k * k),
+        seed: Some(1),
+        area_fraction,
+        ..Params::default()
+    };
+    let scenario =
+        builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
+    Ok((k * k, scenario))
+}
+
 /// Measures one configuration.
 pub fn measure(
     balls: usize,
@@ -189,23 +207,15 @@ pub fn measure(
     events: u64,
     cell_diameters: f64,
 ) -> Result<BenchRow, String> {
-    let k = ((balls as f64).sqrt().round() as usize).max(1);
     let start = Instant::now();
-    let params = Params {
-        balls: Some(k * k),
-        seed: Some(1),
-        area_fraction: Some(area_fraction),
-        ..Params::default()
-    };
-    let scenario =
-        builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
+    let (n_balls, scenario) = thesis_gas(balls, Some(area_fraction))?;
     let opts = Options {
         cell_diameters,
         ..Options::default()
     };
     let mut engine = EventList::new(&scenario, opts);
     let setup = start.elapsed().as_secs_f64();
-    let target = events.max(5 * (k * k) as u64);
+    let target = events.max(5 * n_balls as u64);
     let start = Instant::now();
     let out = engine
         .run_for(f64::INFINITY, target, &mut Ignore)
@@ -213,7 +223,7 @@ pub fn measure(
     let secs = start.elapsed().as_secs_f64();
     let n = out.events.total();
     Ok(BenchRow {
-        balls: k * k,
+        balls: n_balls,
         area_fraction,
         events: n,
         setup_seconds: setup,
@@ -453,15 +463,7 @@ pub fn measure_objects(
     balls: usize,
     sectors: Option<crate::run::SectorChoice>,
 ) -> Result<ObjectsRow, String> {
-    let k = ((balls as f64).sqrt().round() as usize).max(1);
-    let params = Params {
-        balls: Some(k * k),
-        seed: Some(1),
-        area_fraction: sectors.map(|_| 0.3),
-        ..Params::default()
-    };
-    let mut scenario =
-        builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
+    let (n_balls, mut scenario) = thesis_gas(balls, sectors.map(|_| 0.3))?;
     let start = Instant::now();
     if let Some(choice) = sectors {
         scenario.until = SECTORED_WARM_UP + SECTORED_WINDOW;
@@ -478,7 +480,7 @@ pub fn measure_objects(
             .run(scenario.until, &mut Ignore)
             .map_err(|e| e.to_string())?;
         return Ok(ObjectsRow {
-            balls: k * k,
+            balls: n_balls,
             events: out.events.total(),
             messages: sent(&out) - sent(&warm),
             seconds: measured.elapsed().as_secs_f64(),
@@ -494,7 +496,7 @@ pub fn measure_objects(
         .map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     Ok(ObjectsRow {
-        balls: k * k,
+        balls: n_balls,
         events: out.events.total(),
         messages: out.messages.iter().map(|(_, c)| c).sum(),
         seconds,
@@ -528,14 +530,7 @@ pub struct TwRow {
 /// objects engine and under Time Warp on 1 and 2 workers; fails if any digest differs.
 pub fn measure_time_warp(balls: usize, until: f64) -> Result<Vec<TwRow>, String> {
     use crate::run::{execute, EngineKind, RunConfig, SectorChoice};
-    let k = ((balls as f64).sqrt().round() as usize).max(1);
-    let params = Params {
-        balls: Some(k * k),
-        seed: Some(1),
-        ..Params::default()
-    };
-    let scenario =
-        builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
+    let (n_balls, scenario) = thesis_gas(balls, None)?;
     let mut rows: Vec<TwRow> = Vec::new();
     for workers in [0, 1, 2] {
         let engine = match workers {
@@ -569,14 +564,13 @@ pub fn measure_time_warp(balls: usize, until: f64) -> Result<Vec<TwRow>, String>
                 return Err(format!(
                     "bench: Time Warp on {workers} workers ended in state {digest}, the \
                      sequential engine in {} ({} balls until {until})",
-                    first.digest,
-                    k * k
+                    first.digest, n_balls
                 ));
             }
         }
         let seconds = report.wall_seconds;
         rows.push(TwRow {
-            balls: k * k,
+            balls: n_balls,
             until,
             workers,
             seconds,

@@ -63,18 +63,17 @@ impl Floor {
 
     /// Whether the batch of object `to` at `time` comes before this floor (and is final).
     pub fn passed(&self, time: &VTime, to: u32) -> bool {
-        time.key
-            .t
-            .total_cmp(&self.t)
-            .then_with(|| {
-                time.key
-                    .path
-                    .as_slice()
-                    .cmp(&self.path[..usize::from(self.len)])
-            })
-            .then(time.gen.cmp(&self.gen))
-            .then(to.cmp(&self.to))
-            .is_lt()
+        self.cmp_with(time.key.t, &time.key.path, time.gen, to)
+            .is_gt()
+    }
+
+    /// How this floor compares with the place (time `t`, key path, generation, receiver).
+    fn cmp_with(&self, t: f64, path: &[u64], gen: u32, to: u32) -> Ordering {
+        self.t
+            .total_cmp(&t)
+            .then_with(|| self.path[..usize::from(self.len)].cmp(path))
+            .then(self.gen.cmp(&gen))
+            .then(self.to.cmp(&to))
     }
 
     /// The smaller of two floors.
@@ -112,13 +111,7 @@ impl Floor {
 
 impl PartialOrd for Floor {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(
-            self.t
-                .total_cmp(&o.t)
-                .then_with(|| self.path[..usize::from(self.len)].cmp(&o.path[..usize::from(o.len)]))
-                .then(self.gen.cmp(&o.gen))
-                .then(self.to.cmp(&o.to)),
-        )
+        Some(self.cmp_with(o.t, &o.path[..usize::from(o.len)], o.gen, o.to))
     }
 }
 
