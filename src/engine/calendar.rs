@@ -1,27 +1,43 @@
 //! The pending-event set of the event-list engine: a calendar queue with one entry per ball.
 //!
 //! Time is cut into buckets of a fixed width; a ring of buckets covers the near future and an
-//! overflow list holds the rest. Only the current bucket is kept ordered, in a small binary heap
+//! overflow list holds the rest. Only the opened buckets are kept ordered, in a small binary heap
 //! indexed by ball, so inserting, moving and removing a ball's event cost O(1) memory touches,
 //! however many balls there are (the O(1) queue of G. Paul, J. Comput. Phys. 221, 2007). A
 //! tournament tree over a million balls costs some twenty cache misses per update instead.
 //!
-//! Buckets are singly linked lists of small nodes, and an entry is removed lazily: moving a ball's
-//! event only forgets the node it had (the ball's [`Place`] no longer names it), and the dead node
-//! is dropped when its bucket comes up. So queueing a ball touches its own record, the bucket's
-//! head and a recycled node, and never another ball's record.
+//! Buckets are singly linked lists of small nodes that carry their event's time, and an entry is
+//! removed lazily: moving a ball's event only forgets the node it had (the ball's place, kept
+//! here in one compact array, no longer names it), and the dead node is dropped when its bucket
+//! comes up. So the calendar never reads a ball's own record, except to break a tie in time.
+//!
+//! At a million balls the ring's heads and the balls' records are far apart in memory, and the
+//! queue is laid out so that no trip there stalls the engine:
+//! - a new node is linked into its bucket a few insertions later, once the bucket's head, asked
+//!   for at once, has arrived (a node due in a bucket being opened is linked first);
+//! - buckets are opened one or two ahead of the events being run, and each ball found there is
+//!   announced twice to the caller ([`Entries::opened`], [`Entries::approaching`]), so that its
+//!   records and then the records its event will read are loaded before it comes up.
 //!
 //! The order is exactly the virtual-time order: a bucket holds events by time only, and the heap
-//! orders the current bucket by full [`Key`], so ties within an instant come out as DESIGN.md
+//! orders the opened buckets by full [`Key`], so ties within an instant come out as DESIGN.md
 //! says whatever the bucket width.
 
+use super::prefetch::prefetch;
 use crate::vtime::Key;
 use std::cmp::Ordering;
+use std::collections::VecDeque;
 
 const NIL: u32 = u32::MAX;
 
+/// Insertions a new node waits before it is linked into its bucket.
+const LINK_DELAY: usize = 8;
+
+/// Entries the heap holds before no further bucket is opened ahead of time.
+const AHEAD: usize = 8;
+
 /// Where a ball's entry is, packed in one word the caller keeps with the ball: not queued, in
-/// the current bucket's heap at an index, or in a ring bucket or the overflow list at a node.
+/// the heap at an index, or in a ring bucket or the overflow list at a node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Place(u32);
 
@@ -55,7 +71,7 @@ impl Place {
     }
 }
 
-/// What the calendar reads and writes in the caller's per-ball records.
+/// What the calendar reads and writes in the caller's per-ball records, and the hints it gives.
 pub trait Entries {
     /// Ball `i`'s queued key (an infinite time: not queued).
     fn key(&self, i: u32) -> &Key;
@@ -63,22 +79,36 @@ pub trait Entries {
     fn place(&self, i: u32) -> Place;
     /// Records where ball `i`'s entry is.
     fn set_place(&mut self, i: u32, place: Place);
-    /// Ball `i`'s bucket has just been opened: its event comes up soon (a hint for prefetching).
+    /// A node of ball `i` was found in a bucket being opened: its record will be read at the
+    /// next event (a hint to start loading it).
     fn opened(&self, _i: u32) {}
+    /// Ball `i`'s event comes up in a few events, and its record is at hand (a hint to start
+    /// loading what its event will read).
+    fn approaching(&self, _i: u32) {}
 }
 
-/// A bucket list node: a ball and the next node.
+/// A bucket list node: an event's time, its ball and the next node.
 #[derive(Clone, Copy, Debug)]
 struct Node {
+    t: f64,
     ball: u32,
     next: u32,
 }
 
-/// The calendar queue. It stores ball indices and reaches their keys through [`Entries`].
+/// A heap entry: an event's time and its ball.
+#[derive(Clone, Copy, Debug)]
+struct Item {
+    t: f64,
+    ball: u32,
+}
+
+/// The calendar queue. It stores ball indices and their times, and reaches their keys through
+/// [`Entries`] only to break ties.
 #[derive(Clone, Debug)]
 pub struct Calendar {
     inv_width: f64,
     mask: u64,
+    /// The last opened bucket: every entry of it and of earlier buckets is in the heap.
     base: i64,
     head: Vec<u32>,
     overflow: u32,
@@ -87,7 +117,11 @@ pub struct Calendar {
     nodes: Vec<Node>,
     /// The first recycled node (linked through `next`).
     free: u32,
-    heap: Vec<u32>,
+    heap: Vec<Item>,
+    /// Ring nodes not yet linked, with their buckets' slots, oldest first.
+    unlinked: VecDeque<(u32, u32)>,
+    /// The nodes of bucket `base`, opened but not yet sorted into live and dead.
+    staged: Vec<u32>,
 }
 
 impl Calendar {
@@ -111,6 +145,8 @@ impl Calendar {
             nodes: Vec::with_capacity(n),
             free: NIL,
             heap: Vec::new(),
+            unlinked: VecDeque::with_capacity(LINK_DELAY + 1),
+            staged: Vec::new(),
         }
     }
 
@@ -138,24 +174,36 @@ impl Calendar {
         }
         let b = self.bucket(t);
         if b <= self.base {
-            self.heap_push(e, i);
+            self.heap_push(e, Item { t, ball: i });
         } else if b - self.base < self.ring_len() {
-            let slot = (b as u64 & self.mask) as usize;
-            let node = self.node(i, self.head[slot]);
-            self.head[slot] = node;
+            let slot = (b as u64 & self.mask) as u32;
+            let node = self.node(t, i, NIL);
             e.set_place(i, Place::ring(node));
             self.in_ring += 1;
+            if self.unlinked.len() == LINK_DELAY {
+                let (n, s) = self.unlinked.pop_front().expect("a full queue");
+                self.link(n, s);
+            }
+            prefetch(&self.head[slot as usize]);
+            self.unlinked.push_back((node, slot));
         } else {
-            let node = self.node(i, self.overflow);
+            let node = self.node(t, i, self.overflow);
             self.overflow = node;
             e.set_place(i, Place::overflow(node));
         }
     }
 
-    /// A node for ball `i` in front of `next`, recycled where one is free.
+    /// Puts node `n` at the front of the bucket at `slot`.
     #[inline]
-    fn node(&mut self, ball: u32, next: u32) -> u32 {
-        let node = Node { ball, next };
+    fn link(&mut self, n: u32, slot: u32) {
+        self.nodes[n as usize].next = self.head[slot as usize];
+        self.head[slot as usize] = n;
+    }
+
+    /// A node for ball `i` at time `t` in front of `next`, recycled where one is free.
+    #[inline]
+    fn node(&mut self, t: f64, ball: u32, next: u32) -> u32 {
+        let node = Node { t, ball, next };
         if self.free == NIL {
             self.nodes.push(node);
             let k = self.nodes.len() as u32 - 1;
@@ -175,7 +223,6 @@ impl Calendar {
         self.free = node;
     }
 
-    /// Takes ball `i`'s entry out: at once from the heap, lazily from a list.
     fn remove<E: Entries + ?Sized>(&mut self, e: &mut E, i: u32) {
         let p = e.place(i);
         match p.tag() {
@@ -186,27 +233,40 @@ impl Calendar {
         e.set_place(i, Place::NOWHERE);
     }
 
-    /// The ball with the earliest event, or `None` if no ball has one.
+    /// The ball with the earliest key, if any (it stays queued until it is set again).
     #[inline]
     pub fn first<E: Entries + ?Sized>(&mut self, e: &mut E) -> Option<u32> {
-        while self.heap.is_empty() {
+        self.sort_staged(e);
+        // open buckets ahead while the ring has entries, so that balls are announced early
+        while self.heap.len() < AHEAD && (self.heap.is_empty() || self.in_ring > 0) {
             if !self.advance(e) {
-                return None;
+                break;
+            }
+            // the opened bucket waits for the next call unless the heap has nothing before it
+            if self
+                .heap
+                .first()
+                .is_none_or(|top| self.bucket(top.t) >= self.base)
+            {
+                self.sort_staged(e);
+            } else {
+                break;
             }
         }
-        Some(self.heap[0])
+        self.heap.first().map(|it| it.ball)
     }
 
-    /// Moves to the next bucket with entries; false when the calendar is empty.
+    /// Opens the next bucket (skipping ahead to the overflow list's earliest when the ring is
+    /// empty): stages its nodes and announces their balls; false when nothing is queued in the
+    /// ring or the overflow list.
     fn advance<E: Entries + ?Sized>(&mut self, e: &mut E) -> bool {
         if self.in_ring == 0 {
-            // jump straight to the earliest live overflow entry
             let mut k = self.overflow;
             let mut earliest = i64::MAX;
             while k != NIL {
-                let Node { ball, next } = self.nodes[k as usize];
+                let Node { t, ball, next } = self.nodes[k as usize];
                 if e.place(ball) == Place::overflow(k) {
-                    earliest = earliest.min(self.bucket(e.key(ball).t));
+                    earliest = earliest.min(self.bucket(t));
                 }
                 k = next;
             }
@@ -220,23 +280,41 @@ impl Calendar {
         if self.base & self.mask as i64 == 0 || self.in_ring == 0 {
             self.pull_overflow(e);
         }
-        let slot = (self.base as u64 & self.mask) as usize;
-        let mut k = self.head[slot];
-        self.head[slot] = NIL;
-        while k != NIL {
-            let Node { ball, next } = self.nodes[k as usize];
-            if e.place(ball) == Place::ring(k) {
-                self.in_ring -= 1;
-                e.opened(ball);
-                self.heap_push(e, ball);
+        let slot = (self.base as u64 & self.mask) as u32;
+        let mut k = 0;
+        while k < self.unlinked.len() {
+            if self.unlinked[k].1 == slot {
+                let (n, s) = self.unlinked.remove(k).expect("an index in range");
+                self.link(n, s);
+            } else {
+                k += 1;
             }
-            self.recycle(k);
+        }
+        let mut k = self.head[slot as usize];
+        self.head[slot as usize] = NIL;
+        while k != NIL {
+            let Node { ball, next, .. } = self.nodes[k as usize];
+            e.opened(ball);
+            self.staged.push(k);
             k = next;
         }
         true
     }
 
-    /// Recycles every node of the overflow list (all of them dead).
+    /// Moves the staged nodes' live entries into the heap and recycles the nodes (a node is
+    /// recycled only here, so that a staged node cannot be taken for a newer one of its ball).
+    fn sort_staged<E: Entries + ?Sized>(&mut self, e: &mut E) {
+        for n in std::mem::take(&mut self.staged) {
+            let Node { t, ball, .. } = self.nodes[n as usize];
+            if e.place(ball) == Place::ring(n) {
+                self.in_ring -= 1;
+                e.approaching(ball);
+                self.heap_push(e, Item { t, ball });
+            }
+            self.recycle(n);
+        }
+    }
+
     fn drop_overflow(&mut self) {
         let mut k = self.overflow;
         self.overflow = NIL;
@@ -247,15 +325,15 @@ impl Calendar {
         }
     }
 
-    /// Moves overflow entries that now fall inside the ring's window into it, and drops dead ones.
+    /// Moves the overflow entries that now fall within the ring into it.
     fn pull_overflow<E: Entries + ?Sized>(&mut self, e: &mut E) {
         let mut k = self.overflow;
         self.overflow = NIL;
         while k != NIL {
-            let Node { ball, next } = self.nodes[k as usize];
+            let Node { t, ball, next } = self.nodes[k as usize];
             if e.place(ball) != Place::overflow(k) {
                 self.recycle(k);
-            } else if self.bucket(e.key(ball).t) - self.base < self.ring_len() {
+            } else if self.bucket(t) - self.base < self.ring_len() {
                 self.recycle(k);
                 e.set_place(ball, Place::NOWHERE);
                 self.insert(e, ball);
@@ -267,20 +345,20 @@ impl Calendar {
         }
     }
 
+    /// Whether `a` comes before `b`: by time, and by the full keys on a tie.
     #[inline]
-    fn less<E: Entries + ?Sized>(e: &E, a: u32, b: u32) -> bool {
-        let (ka, kb) = (e.key(a), e.key(b));
-        match ka.t.total_cmp(&kb.t) {
+    fn less<E: Entries + ?Sized>(e: &E, a: &Item, b: &Item) -> bool {
+        match a.t.total_cmp(&b.t) {
             Ordering::Less => true,
             Ordering::Greater => false,
-            Ordering::Equal => ka.path < kb.path,
+            Ordering::Equal => e.key(a.ball).path < e.key(b.ball).path,
         }
     }
 
-    fn heap_push<E: Entries + ?Sized>(&mut self, e: &mut E, i: u32) {
-        self.heap.push(i);
+    fn heap_push<E: Entries + ?Sized>(&mut self, e: &mut E, it: Item) {
+        self.heap.push(it);
         let k = self.heap.len() - 1;
-        e.set_place(i, Place::heap(k));
+        e.set_place(it.ball, Place::heap(k));
         self.sift_up(e, k);
     }
 
@@ -288,7 +366,7 @@ impl Calendar {
         let last = self.heap.pop().expect("the entry is in the heap");
         if k < self.heap.len() {
             self.heap[k] = last;
-            e.set_place(last, Place::heap(k));
+            e.set_place(last.ball, Place::heap(k));
             let k = self.sift_up(e, k);
             self.sift_down(e, k);
         }
@@ -297,7 +375,7 @@ impl Calendar {
     fn sift_up<E: Entries + ?Sized>(&mut self, e: &mut E, mut k: usize) -> usize {
         while k > 0 {
             let p = (k - 1) / 2;
-            if Self::less(e, self.heap[k], self.heap[p]) {
+            if Self::less(e, &self.heap[k], &self.heap[p]) {
                 self.swap(e, k, p);
                 k = p;
             } else {
@@ -311,10 +389,10 @@ impl Calendar {
         loop {
             let (l, r) = (2 * k + 1, 2 * k + 2);
             let mut m = k;
-            if l < self.heap.len() && Self::less(e, self.heap[l], self.heap[m]) {
+            if l < self.heap.len() && Self::less(e, &self.heap[l], &self.heap[m]) {
                 m = l;
             }
-            if r < self.heap.len() && Self::less(e, self.heap[r], self.heap[m]) {
+            if r < self.heap.len() && Self::less(e, &self.heap[r], &self.heap[m]) {
                 m = r;
             }
             if m == k {
@@ -328,14 +406,16 @@ impl Calendar {
     #[inline]
     fn swap<E: Entries + ?Sized>(&mut self, e: &mut E, a: usize, b: usize) {
         self.heap.swap(a, b);
-        e.set_place(self.heap[a], Place::heap(a));
-        e.set_place(self.heap[b], Place::heap(b));
+        e.set_place(self.heap[a].ball, Place::heap(a));
+        e.set_place(self.heap[b].ball, Place::heap(b));
     }
 
     /// Bytes of memory held.
     pub fn memory_bytes(&self) -> usize {
-        4 * (self.head.len() + self.heap.capacity())
-            + std::mem::size_of::<Node>() * self.nodes.capacity()
+        use std::mem::size_of;
+        4 * self.head.len()
+            + size_of::<Item>() * self.heap.capacity()
+            + size_of::<Node>() * self.nodes.capacity()
     }
 }
 

@@ -24,7 +24,7 @@
 
 use super::calendar::{Calendar, Entries, Place};
 use super::grid::Grid;
-use super::prefetch::prefetch;
+use super::prefetch::{prefetch, prefetch_all};
 use super::{
     BallState, Event, EventCounts, EventKind, Fixed, Frame, Observer, Outcome, RunError, Span,
     Table, World,
@@ -133,11 +133,16 @@ impl Entries for Queued<'_> {
     fn set_place(&mut self, i: u32, place: Place) {
         self.own[i as usize].place = place;
     }
-    /// The ball's event is a few events away: start loading the slots it will read.
+    /// The ball's record is read at the next event: start loading it, and its slot.
     #[inline]
     fn opened(&self, i: u32) {
-        let own = &self.own[i as usize];
+        prefetch_all(&self.own[i as usize]);
         prefetch(&self.slots[i as usize]);
+    }
+    /// Its records have arrived: start loading the slots and cells its event will read.
+    #[inline]
+    fn approaching(&self, i: u32) {
+        let own = &self.own[i as usize];
         if own.queued.path[..] == [CELL_CROSSING] {
             self.grid.prefetch_near(own.cross_cell);
         } else if let Partner::Ball(j, _) = own.phys.partner {

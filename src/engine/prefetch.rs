@@ -15,3 +15,13 @@ pub fn prefetch<T>(r: &T) {
     #[cfg(not(target_arch = "x86_64"))]
     let _ = r;
 }
+
+/// [`prefetch`] for every cache line of a record larger than one.
+#[inline(always)]
+pub fn prefetch_all<T>(r: &T) {
+    let base = std::ptr::from_ref(r).cast::<u8>();
+    for offset in (0..std::mem::size_of::<T>()).step_by(64) {
+        // SAFETY: `offset` is within the record, so the pointer stays inside one allocation.
+        prefetch(unsafe { &*base.add(offset) });
+    }
+}
