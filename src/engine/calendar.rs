@@ -6,18 +6,21 @@
 //! however many balls there are (the O(1) queue of G. Paul, J. Comput. Phys. 221, 2007). A
 //! tournament tree over a million balls costs some twenty cache misses per update instead.
 //!
-//! Buckets are singly linked lists of small nodes that carry their event's time, and an entry is
-//! removed lazily: moving a ball's event only forgets the node it had (the ball's place, kept
-//! here in one compact array, no longer names it), and the dead node is dropped when its bucket
-//! comes up. So the calendar never reads a ball's own record, except to break a tie in time.
+//! A bucket is one cache line holding the times and balls of up to four entries, with more
+//! chained to it in chunks of the same size, and an entry is removed lazily: moving a ball's
+//! event only forgets the entry it had (the ball's [`Place`] no longer names it), and the dead
+//! entry is dropped when its bucket comes up. So the calendar reads a ball's own record only to
+//! check its place, and to break a tie in time.
 //!
-//! At a million balls the ring's heads and the balls' records are far apart in memory, and the
-//! queue is laid out so that no trip there stalls the engine:
-//! - a new node is linked into its bucket a few insertions later, once the bucket's head, asked
-//!   for at once, has arrived (a node due in a bucket being opened is linked first);
-//! - buckets are opened one or two ahead of the events being run, and each ball found there is
-//!   announced twice to the caller ([`Entries::opened`], [`Entries::approaching`]), so that its
-//!   records and then the records its event will read are loaded before it comes up.
+//! At a million balls the buckets and the balls' records are far apart in memory, and the queue
+//! is laid out so that no trip there stalls the engine:
+//! - a new entry is written into its bucket a few insertions later, once the bucket's line,
+//!   asked for at once, has arrived (an entry due in a bucket being opened is written first);
+//! - buckets are asked for a few buckets before they are opened, and opened one or two buckets
+//!   ahead of the events being run; each ball found in one is announced twice to the caller
+//!   ([`Entries::opened`], [`Entries::approaching`]), and its entry is checked only at the
+//!   next event, so that its record and then the records its event will read are loaded before
+//!   they are needed.
 //!
 //! The order is exactly the virtual-time order: a bucket holds events by time only, and the heap
 //! orders the opened buckets by full [`Key`], so ties within an instant come out as DESIGN.md
@@ -30,14 +33,30 @@ use std::collections::VecDeque;
 
 const NIL: u32 = u32::MAX;
 
-/// Insertions a new node waits before it is linked into its bucket.
-const LINK_DELAY: usize = 8;
+/// Insertions a new entry waits before it is written into its bucket.
+const WRITE_DELAY: usize = 8;
 
 /// Entries the heap holds before no further bucket is opened ahead of time.
-const AHEAD: usize = 8;
+const AHEAD: usize = 4;
+
+/// Buckets between the one being opened and the one asked for.
+const PREFETCH_BUCKETS: i64 = 4;
+
+/// Entries per chunk (one cache line).
+const PER_CHUNK: usize = 4;
+
+/// Entries (live or dead) a bucket should receive: most buckets then fit in their first chunk.
+/// The width is set again when the rate of insertions makes it stray out of [`FEW`, `MANY`].
+const TARGET: f64 = 2.0;
+const FEW: f64 = 0.5;
+const MANY: f64 = 4.0;
+
+/// Ring places from this index on name entries not yet written into their buckets.
+const WAITING: u32 = 1 << 29;
 
 /// Where a ball's entry is, packed in one word the caller keeps with the ball: not queued, in
-/// the heap at an index, or in a ring bucket or the overflow list at a node.
+/// the heap at an index, in a ring bucket at an entry (chunk and position, or a mark while it
+/// waits to be written), or in the overflow list at an index.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Place(u32);
 
@@ -54,12 +73,12 @@ impl Place {
         Place(HEAP | k as u32)
     }
 
-    fn ring(node: u32) -> Place {
-        Place(RING | node)
+    fn ring(entry: u32) -> Place {
+        Place(RING | entry)
     }
 
-    fn overflow(node: u32) -> Place {
-        Place(OVERFLOW | node)
+    fn overflow(k: usize) -> Place {
+        Place(OVERFLOW | k as u32)
     }
 
     fn tag(self) -> u32 {
@@ -79,7 +98,7 @@ pub trait Entries {
     fn place(&self, i: u32) -> Place;
     /// Records where ball `i`'s entry is.
     fn set_place(&mut self, i: u32, place: Place);
-    /// A node of ball `i` was found in a bucket being opened: its record will be read at the
+    /// An entry of ball `i` was found in a bucket being opened: its record will be read at the
     /// next event (a hint to start loading it).
     fn opened(&self, _i: u32) {}
     /// Ball `i`'s event comes up in a few events, and its record is at hand (a hint to start
@@ -87,13 +106,22 @@ pub trait Entries {
     fn approaching(&self, _i: u32) {}
 }
 
-/// A bucket list node: an event's time, its ball and the next node.
+/// Up to four entries of a bucket in one cache line, and the chunk with its further entries.
 #[derive(Clone, Copy, Debug)]
-struct Node {
-    t: f64,
-    ball: u32,
-    next: u32,
+#[repr(C, align(64))]
+struct Chunk {
+    t: [f64; PER_CHUNK],
+    ball: [u32; PER_CHUNK],
+    len: u32,
+    more: u32,
 }
+
+const EMPTY: Chunk = Chunk {
+    t: [0.0; PER_CHUNK],
+    ball: [0; PER_CHUNK],
+    len: 0,
+    more: NIL,
+};
 
 /// A heap entry: an event's time and its ball.
 #[derive(Clone, Copy, Debug)]
@@ -102,35 +130,55 @@ struct Item {
     ball: u32,
 }
 
-/// The calendar queue. It stores ball indices and their times, and reaches their keys through
-/// [`Entries`] only to break ties.
+/// An entry waiting to be written into its bucket.
+#[derive(Clone, Copy, Debug)]
+struct Waiting {
+    t: f64,
+    ball: u32,
+    slot: u32,
+    /// The ball's place while it waits.
+    mark: u32,
+}
+
+/// The calendar queue. It stores ball indices and their times, and reaches the balls' records
+/// through [`Entries`] for their places and to break ties.
 #[derive(Clone, Debug)]
 pub struct Calendar {
     inv_width: f64,
     mask: u64,
-    /// The last opened bucket: every entry of it and of earlier buckets is in the heap.
+    /// The last opened bucket: every live entry of it and of earlier buckets is in the heap.
     base: i64,
-    head: Vec<u32>,
-    overflow: u32,
+    /// The ring's buckets (the first `mask + 1` chunks), then chunks chained to them.
+    chunks: Vec<Chunk>,
+    /// The first free chained chunk (linked through `more`).
+    free: u32,
     /// Live entries in the ring.
     in_ring: usize,
-    nodes: Vec<Node>,
-    /// The first recycled node (linked through `next`).
-    free: u32,
+    overflow: Vec<(f64, u32)>,
     heap: Vec<Item>,
-    /// Ring nodes not yet linked, with their buckets' slots, oldest first.
-    unlinked: VecDeque<(u32, u32)>,
-    /// The nodes of bucket `base`, opened but not yet sorted into live and dead.
-    staged: Vec<u32>,
+    /// Entries not yet written into their buckets, oldest first.
+    waiting: VecDeque<Waiting>,
+    /// Counter of the marks of waiting entries.
+    marks: u32,
+    /// The entries of bucket `base`, opened but not yet sorted into live and dead: time, ball
+    /// and entry.
+    staged: Vec<(f64, u32, u32)>,
+    /// The chained chunks of bucket `base`, freed once it is sorted.
+    staged_chunks: Vec<u32>,
+    /// Calls to [`Calendar::first`] and insertions since the rate was last measured, and the
+    /// earliest time then.
+    calls: u64,
+    sets: u64,
+    since: f64,
 }
 
 impl Calendar {
     /// A calendar for `n` balls, starting at time `start`, whose events are about `mean_gap`
-    /// apart in time overall (a bucket is a few mean gaps wide; the ring holds about `n` buckets).
+    /// apart in time overall (a bucket is two mean gaps wide; the ring holds about `2n` buckets).
     pub fn new(n: usize, start: f64, mean_gap: f64) -> Calendar {
-        let buckets = n.next_power_of_two().clamp(16, 1 << 22);
+        let buckets = (2 * n).next_power_of_two().clamp(16, 1 << 23);
         let width = if mean_gap.is_finite() && mean_gap > 0.0 {
-            4.0 * mean_gap
+            2.0 * mean_gap
         } else {
             1.0
         };
@@ -139,25 +187,46 @@ impl Calendar {
             inv_width,
             mask: buckets as u64 - 1,
             base: (start * inv_width).floor() as i64,
-            head: vec![NIL; buckets],
-            overflow: NIL,
-            in_ring: 0,
-            nodes: Vec::with_capacity(n),
+            chunks: vec![EMPTY; buckets],
             free: NIL,
+            in_ring: 0,
+            overflow: Vec::new(),
             heap: Vec::new(),
-            unlinked: VecDeque::with_capacity(LINK_DELAY + 1),
+            waiting: VecDeque::with_capacity(WRITE_DELAY + 1),
+            marks: 0,
             staged: Vec::new(),
+            staged_chunks: Vec::new(),
+            calls: 0,
+            sets: 0,
+            since: start,
         }
+    }
+
+    /// A calendar of a single bucket, all of it in the heap: for a first pass, before the
+    /// spacing of the events is known.
+    pub fn heap_only(start: f64) -> Calendar {
+        let mut c = Calendar::new(0, start, 1.0);
+        c.inv_width = 0.0;
+        c.base = 0;
+        c
     }
 
     #[inline]
     fn bucket(&self, t: f64) -> i64 {
-        (t * self.inv_width).floor() as i64
+        // floor without a call into libm (x86-64 has no rounding instruction by default)
+        let x = t * self.inv_width;
+        let i = x as i64;
+        i - i64::from((i as f64) > x)
     }
 
     #[inline]
     fn ring_len(&self) -> i64 {
         self.mask as i64 + 1
+    }
+
+    #[inline]
+    fn slot(&self, b: i64) -> u32 {
+        (b as u64 & self.mask) as u32
     }
 
     /// Sets ball `i`'s event to its current key (replacing any earlier one).
@@ -172,55 +241,72 @@ impl Calendar {
         if !t.is_finite() {
             return;
         }
+        self.sets += 1;
         let b = self.bucket(t);
         if b <= self.base {
             self.heap_push(e, Item { t, ball: i });
         } else if b - self.base < self.ring_len() {
-            let slot = (b as u64 & self.mask) as u32;
-            let node = self.node(t, i, NIL);
-            e.set_place(i, Place::ring(node));
+            let slot = self.slot(b);
+            let mark = WAITING | (self.marks & (WAITING - 1));
+            self.marks = self.marks.wrapping_add(1);
+            e.set_place(i, Place::ring(mark));
             self.in_ring += 1;
-            if self.unlinked.len() == LINK_DELAY {
-                let (n, s) = self.unlinked.pop_front().expect("a full queue");
-                self.link(n, s);
+            if self.waiting.len() == WRITE_DELAY {
+                let w = self.waiting.pop_front().expect("a full queue");
+                self.write(e, w);
             }
-            prefetch(&self.head[slot as usize]);
-            self.unlinked.push_back((node, slot));
+            prefetch(&self.chunks[slot as usize]);
+            self.waiting.push_back(Waiting {
+                t,
+                ball: i,
+                slot,
+                mark,
+            });
         } else {
-            let node = self.node(t, i, self.overflow);
-            self.overflow = node;
-            e.set_place(i, Place::overflow(node));
+            e.set_place(i, Place::overflow(self.overflow.len()));
+            self.overflow.push((t, i));
         }
     }
 
-    /// Puts node `n` at the front of the bucket at `slot`.
-    #[inline]
-    fn link(&mut self, n: u32, slot: u32) {
-        self.nodes[n as usize].next = self.head[slot as usize];
-        self.head[slot as usize] = n;
+    /// Writes a waiting entry into its bucket, unless its ball has moved on meanwhile.
+    fn write<E: Entries + ?Sized>(&mut self, e: &mut E, w: Waiting) {
+        if e.place(w.ball) != Place::ring(w.mark) {
+            return;
+        }
+        let slot = w.slot as usize;
+        let mut c = slot;
+        if self.chunks[slot].len as usize == PER_CHUNK {
+            let more = self.chunks[slot].more;
+            c = if more != NIL && (self.chunks[more as usize].len as usize) < PER_CHUNK {
+                more as usize
+            } else {
+                let fresh = self.chain(more);
+                self.chunks[slot].more = fresh;
+                fresh as usize
+            };
+        }
+        let chunk = &mut self.chunks[c];
+        let k = chunk.len as usize;
+        chunk.t[k] = w.t;
+        chunk.ball[k] = w.ball;
+        chunk.len += 1;
+        let entry = (c * PER_CHUNK + k) as u32;
+        assert!(entry < WAITING, "calendar entries exhausted");
+        e.set_place(w.ball, Place::ring(entry));
     }
 
-    /// A node for ball `i` at time `t` in front of `next`, recycled where one is free.
-    #[inline]
-    fn node(&mut self, t: f64, ball: u32, next: u32) -> u32 {
-        let node = Node { t, ball, next };
+    /// An empty chained chunk in front of `more`, recycled where one is free.
+    fn chain(&mut self, more: u32) -> u32 {
+        let chunk = Chunk { more, ..EMPTY };
         if self.free == NIL {
-            self.nodes.push(node);
-            let k = self.nodes.len() as u32 - 1;
-            assert!(k < HEAP, "calendar nodes exhausted");
-            k
+            self.chunks.push(chunk);
+            self.chunks.len() as u32 - 1
         } else {
             let k = self.free;
-            self.free = self.nodes[k as usize].next;
-            self.nodes[k as usize] = node;
+            self.free = self.chunks[k as usize].more;
+            self.chunks[k as usize] = chunk;
             k
         }
-    }
-
-    #[inline]
-    fn recycle(&mut self, node: u32) {
-        self.nodes[node as usize].next = self.free;
-        self.free = node;
     }
 
     fn remove<E: Entries + ?Sized>(&mut self, e: &mut E, i: u32) {
@@ -237,6 +323,10 @@ impl Calendar {
     #[inline]
     pub fn first<E: Entries + ?Sized>(&mut self, e: &mut E) -> Option<u32> {
         self.sort_staged(e);
+        self.calls += 1;
+        if self.calls >= (self.ring_len() as u64 / 16).max(1024) {
+            self.measure(e);
+        }
         // open buckets ahead while the ring has entries, so that balls are announced early
         while self.heap.len() < AHEAD && (self.heap.is_empty() || self.in_ring > 0) {
             if !self.advance(e) {
@@ -257,91 +347,148 @@ impl Calendar {
     }
 
     /// Opens the next bucket (skipping ahead to the overflow list's earliest when the ring is
-    /// empty): stages its nodes and announces their balls; false when nothing is queued in the
-    /// ring or the overflow list.
+    /// empty): stages its entries and announces their balls; false when nothing is queued in
+    /// the ring or the overflow list.
     fn advance<E: Entries + ?Sized>(&mut self, e: &mut E) -> bool {
         if self.in_ring == 0 {
-            let mut k = self.overflow;
-            let mut earliest = i64::MAX;
-            while k != NIL {
-                let Node { t, ball, next } = self.nodes[k as usize];
-                if e.place(ball) == Place::overflow(k) {
-                    earliest = earliest.min(self.bucket(t));
-                }
-                k = next;
-            }
-            if earliest == i64::MAX {
-                self.drop_overflow();
+            let earliest = self
+                .overflow
+                .iter()
+                .enumerate()
+                .filter(|&(k, &(_, ball))| e.place(ball) == Place::overflow(k))
+                .map(|(_, &(t, _))| self.bucket(t))
+                .min();
+            let Some(earliest) = earliest else {
+                self.overflow.clear();
                 return false;
-            }
+            };
             self.base = earliest - 1;
         }
         self.base += 1;
         if self.base & self.mask as i64 == 0 || self.in_ring == 0 {
             self.pull_overflow(e);
         }
-        let slot = (self.base as u64 & self.mask) as u32;
+        let slot = self.slot(self.base);
         let mut k = 0;
-        while k < self.unlinked.len() {
-            if self.unlinked[k].1 == slot {
-                let (n, s) = self.unlinked.remove(k).expect("an index in range");
-                self.link(n, s);
+        while k < self.waiting.len() {
+            if self.waiting[k].slot == slot {
+                let w = self.waiting.remove(k).expect("an index in range");
+                self.write(e, w);
             } else {
                 k += 1;
             }
         }
-        let mut k = self.head[slot as usize];
-        self.head[slot as usize] = NIL;
-        while k != NIL {
-            let Node { ball, next, .. } = self.nodes[k as usize];
-            e.opened(ball);
-            self.staged.push(k);
-            k = next;
+        prefetch(&self.chunks[self.slot(self.base + PREFETCH_BUCKETS) as usize]);
+        let mut c = slot as usize;
+        loop {
+            let chunk = self.chunks[c];
+            for k in 0..chunk.len as usize {
+                e.opened(chunk.ball[k]);
+                let entry = (c * PER_CHUNK + k) as u32;
+                self.staged.push((chunk.t[k], chunk.ball[k], entry));
+            }
+            if c != slot as usize {
+                self.staged_chunks.push(c as u32);
+            }
+            if chunk.more == NIL {
+                break;
+            }
+            c = chunk.more as usize;
         }
+        self.chunks[slot as usize].len = 0;
+        self.chunks[slot as usize].more = NIL;
         true
     }
 
-    /// Moves the staged nodes' live entries into the heap and recycles the nodes (a node is
-    /// recycled only here, so that a staged node cannot be taken for a newer one of its ball).
+    /// Measures how many entries a bucket receives at the rate of insertions since the last
+    /// measure, and sets the width again if that strays too far from [`TARGET`].
+    fn measure<E: Entries + ?Sized>(&mut self, e: &mut E) {
+        let Some(now) = self.heap.first().map(|it| it.t) else {
+            return;
+        };
+        let dt = now - self.since;
+        if dt > 0.0 && self.sets > 0 && self.inv_width > 0.0 {
+            let per_bucket = self.sets as f64 / (dt * self.inv_width);
+            if !(FEW..=MANY).contains(&per_bucket) {
+                self.rebuild(e, TARGET / per_bucket);
+            }
+        }
+        self.calls = 0;
+        self.sets = 0;
+        self.since = now;
+    }
+
+    /// Sets the bucket width to `factor` times what it is and queues the ring's and the
+    /// overflow list's live entries again (the heap keeps its own: the opened time stays
+    /// opened). Called with nothing staged.
+    fn rebuild<E: Entries + ?Sized>(&mut self, e: &mut E, factor: f64) {
+        while let Some(w) = self.waiting.pop_front() {
+            self.write(e, w);
+        }
+        let mut live = Vec::with_capacity(self.in_ring + self.overflow.len());
+        for (c, chunk) in self.chunks.iter().enumerate() {
+            for k in 0..chunk.len as usize {
+                let ball = chunk.ball[k];
+                if e.place(ball) == Place::ring((c * PER_CHUNK + k) as u32) {
+                    live.push(ball);
+                }
+            }
+        }
+        for (k, &(_, ball)) in self.overflow.iter().enumerate() {
+            if e.place(ball) == Place::overflow(k) {
+                live.push(ball);
+            }
+        }
+        // everything before the end of bucket `base` is opened, and stays so
+        let opened_until = (self.base + 1) as f64 / self.inv_width;
+        self.inv_width /= factor.clamp(1.0 / 64.0, 64.0);
+        self.base = self.bucket(opened_until);
+        self.chunks.truncate(self.ring_len() as usize);
+        self.chunks.fill(EMPTY);
+        self.free = NIL;
+        self.overflow.clear();
+        self.in_ring = 0;
+        for ball in live {
+            e.set_place(ball, Place::NOWHERE);
+            self.insert(e, ball);
+        }
+    }
+
+    /// Moves the staged entries that are still live into the heap, and frees the staged
+    /// chunks (only here, so that a staged entry cannot be taken for a newer one).
     fn sort_staged<E: Entries + ?Sized>(&mut self, e: &mut E) {
-        for n in std::mem::take(&mut self.staged) {
-            let Node { t, ball, .. } = self.nodes[n as usize];
-            if e.place(ball) == Place::ring(n) {
+        let mut staged = std::mem::take(&mut self.staged);
+        for &(t, ball, entry) in &staged {
+            if e.place(ball) == Place::ring(entry) {
                 self.in_ring -= 1;
                 e.approaching(ball);
                 self.heap_push(e, Item { t, ball });
             }
-            self.recycle(n);
         }
-    }
-
-    fn drop_overflow(&mut self) {
-        let mut k = self.overflow;
-        self.overflow = NIL;
-        while k != NIL {
-            let next = self.nodes[k as usize].next;
-            self.recycle(k);
-            k = next;
+        staged.clear();
+        self.staged = staged;
+        for k in 0..self.staged_chunks.len() {
+            let c = self.staged_chunks[k];
+            self.chunks[c as usize].more = self.free;
+            self.free = c;
         }
+        self.staged_chunks.clear();
     }
 
     /// Moves the overflow entries that now fall within the ring into it.
     fn pull_overflow<E: Entries + ?Sized>(&mut self, e: &mut E) {
-        let mut k = self.overflow;
-        self.overflow = NIL;
-        while k != NIL {
-            let Node { t, ball, next } = self.nodes[k as usize];
+        let old = std::mem::take(&mut self.overflow);
+        for (k, &(t, ball)) in old.iter().enumerate() {
             if e.place(ball) != Place::overflow(k) {
-                self.recycle(k);
-            } else if self.bucket(t) - self.base < self.ring_len() {
-                self.recycle(k);
+                continue;
+            }
+            if self.bucket(t) - self.base < self.ring_len() {
                 e.set_place(ball, Place::NOWHERE);
                 self.insert(e, ball);
             } else {
-                self.nodes[k as usize].next = self.overflow;
-                self.overflow = k;
+                e.set_place(ball, Place::overflow(self.overflow.len()));
+                self.overflow.push((t, ball));
             }
-            k = next;
         }
     }
 
@@ -413,9 +560,9 @@ impl Calendar {
     /// Bytes of memory held.
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
-        4 * self.head.len()
+        size_of::<Chunk>() * self.chunks.capacity()
+            + size_of::<(f64, u32)>() * self.overflow.capacity()
             + size_of::<Item>() * self.heap.capacity()
-            + size_of::<Node>() * self.nodes.capacity()
     }
 }
 
@@ -445,7 +592,7 @@ mod tests {
 
     proptest! {
         /// Any sequence of sets and pops yields balls in exact key order, like a sorted list,
-        /// and dead nodes are recycled: the pool never outgrows the sets made.
+        /// and chained chunks never outnumber the sets made.
         #[test]
         fn pops_in_key_order(
             n in 1usize..40,
@@ -483,14 +630,14 @@ mod tests {
                     sets += 1;
                 }
             }
-            prop_assert!(cal.nodes.len() <= sets);
+            prop_assert!(cal.chunks.len() <= cal.ring_len() as usize + sets);
         }
     }
 
-    /// Moving the same events again and again while time advances keeps the node pool at the
-    /// size of the live entries plus the dead ones of one ring revolution, not the sets made.
+    /// Moving the same events again and again while time advances keeps the chained chunks
+    /// fewer than the balls, not growing with the sets made.
     #[test]
-    fn dead_nodes_are_recycled() {
+    fn chained_chunks_are_recycled() {
         let n = 64;
         let mut e = Plain {
             keys: (0..n).map(|i| Key::at(1.0 + i as f64, 0)).collect(),
@@ -509,6 +656,54 @@ mod tests {
                 cal.set(&mut e, b);
             }
         }
-        assert!(cal.nodes.len() < 4 * n, "{} nodes", cal.nodes.len());
+        let chained = cal.chunks.len() - cal.ring_len() as usize;
+        assert!(chained < n, "{chained} chained chunks");
+    }
+
+    /// A calendar set up with a mean gap far from the true one finds its width again, and
+    /// still yields events in exact key order before and after.
+    #[test]
+    fn width_adapts_to_the_traffic() {
+        for wrong in [1e-3, 1e3] {
+            let n = 256;
+            let mut rng = 12345u64;
+            let mut next = move || {
+                rng = rng
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (rng >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let mut e = Plain {
+                keys: (0..n)
+                    .map(|i| Key::at(next() * 2.0, pair(i as u32, 1000)))
+                    .collect(),
+                places: vec![Place::NOWHERE; n],
+            };
+            // the true mean gap is about 1 / n
+            let mut cal = Calendar::new(n, 0.0, wrong / n as f64);
+            let before = cal.inv_width;
+            for i in 0..n as u32 {
+                cal.set(&mut e, i);
+            }
+            for _ in 0..200_000 {
+                let want = (0..n as u32)
+                    .min_by(|&a, &b| e.keys[a as usize].cmp(&e.keys[b as usize]))
+                    .expect("balls");
+                let got = cal.first(&mut e).expect("every ball is queued");
+                assert_eq!(e.keys[got as usize], e.keys[want as usize]);
+                let t = e.keys[got as usize].t + next() * 2.0;
+                e.keys[got as usize] = Key::at(t, pair(got, 1000));
+                cal.set(&mut e, got);
+            }
+            let ratio = cal.inv_width / before;
+            assert!(
+                if wrong > 1.0 {
+                    ratio > 10.0
+                } else {
+                    ratio < 0.1
+                },
+                "width ratio {ratio}"
+            );
+        }
     }
 }

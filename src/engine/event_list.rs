@@ -240,7 +240,7 @@ impl EventList {
                 })
                 .collect(),
             pocket: vec![None; n],
-            queue: Calendar::new(n, start, 1.0),
+            queue: Calendar::heap_only(start),
             grid,
             now: start,
             reversal: opts.span.reverse_at.map(|t| Key::at(t, REVERSAL)),
