@@ -42,6 +42,9 @@ const AHEAD: usize = 4;
 /// Buckets between the one being opened and the one asked for.
 const PREFETCH_BUCKETS: i64 = 4;
 
+/// A ring larger than this many bytes is taken to be out of cache.
+const FAR_BYTES: usize = 4 << 20;
+
 /// Entries per chunk (one cache line).
 const PER_CHUNK: usize = 4;
 
@@ -158,6 +161,10 @@ pub struct Calendar {
     heap: Vec<Item>,
     /// Entries not yet written into their buckets, oldest first.
     waiting: VecDeque<Waiting>,
+    /// Whether the ring is too large for the cache, so that entries wait before they are
+    /// written and opened buckets before they are sorted (in cache, waiting costs more than
+    /// it saves).
+    far: bool,
     /// Counter of the marks of waiting entries.
     marks: u32,
     /// The entries of bucket `base`, opened but not yet sorted into live and dead: time, ball
@@ -193,6 +200,7 @@ impl Calendar {
             overflow: Vec::new(),
             heap: Vec::new(),
             waiting: VecDeque::with_capacity(WRITE_DELAY + 1),
+            far: buckets * std::mem::size_of::<Chunk>() > FAR_BYTES,
             marks: 0,
             staged: Vec::new(),
             staged_chunks: Vec::new(),
@@ -251,17 +259,22 @@ impl Calendar {
             self.marks = self.marks.wrapping_add(1);
             e.set_place(i, Place::ring(mark));
             self.in_ring += 1;
+            let w = Waiting {
+                t,
+                ball: i,
+                slot,
+                mark,
+            };
+            if !self.far {
+                self.write(e, w);
+                return;
+            }
             if self.waiting.len() == WRITE_DELAY {
                 let w = self.waiting.pop_front().expect("a full queue");
                 self.write(e, w);
             }
             prefetch(&self.chunks[slot as usize]);
-            self.waiting.push_back(Waiting {
-                t,
-                ball: i,
-                slot,
-                mark,
-            });
+            self.waiting.push_back(w);
         } else {
             e.set_place(i, Place::overflow(self.overflow.len()));
             self.overflow.push((t, i));
@@ -328,15 +341,17 @@ impl Calendar {
             self.measure(e);
         }
         // open buckets ahead while the ring has entries, so that balls are announced early
-        while self.heap.len() < AHEAD && (self.heap.is_empty() || self.in_ring > 0) {
+        let ahead = if self.far { AHEAD } else { 1 };
+        while self.heap.len() < ahead && (self.heap.is_empty() || self.in_ring > 0) {
             if !self.advance(e) {
                 break;
             }
             // the opened bucket waits for the next call unless the heap has nothing before it
-            if self
-                .heap
-                .first()
-                .is_none_or(|top| self.bucket(top.t) >= self.base)
+            if !self.far
+                || self
+                    .heap
+                    .first()
+                    .is_none_or(|top| self.bucket(top.t) >= self.base)
             {
                 self.sort_staged(e);
             } else {
