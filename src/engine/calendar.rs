@@ -17,10 +17,10 @@
 //! - a new entry is written into its bucket a few insertions later, once the bucket's line,
 //!   asked for at once, has arrived (an entry due in a bucket being opened is written first);
 //! - buckets are asked for a few buckets before they are opened, and opened one or two buckets
-//!   ahead of the events being run; each ball found in one is announced twice to the caller
-//!   ([`Entries::opened`], [`Entries::approaching`]), and its entry is checked only at the
-//!   next event, so that its record and then the records its event will read are loaded before
-//!   they are needed.
+//!   ahead of the events being run; each ball found in one is announced at three successive
+//!   events ([`Entries::opened`], [`Entries::approaching`], [`Entries::imminent`]), and its
+//!   entry is checked only at the second, so that its record, then the records its event will
+//!   read, then the records those lead to are loaded before they are needed.
 //!
 //! The order is exactly the virtual-time order: a bucket holds events by time only, and the heap
 //! orders the opened buckets by full [`Key`], so ties within an instant come out as DESIGN.md
@@ -37,7 +37,7 @@ const NIL: u32 = u32::MAX;
 const WRITE_DELAY: usize = 8;
 
 /// Entries the heap holds before no further bucket is opened ahead of time.
-const AHEAD: usize = 4;
+const AHEAD: usize = 8;
 
 /// Buckets between the one being opened and the one asked for.
 const PREFETCH_BUCKETS: i64 = 4;
@@ -107,6 +107,9 @@ pub trait Entries {
     /// Ball `i`'s event comes up in a few events, and its record is at hand (a hint to start
     /// loading what its event will read).
     fn approaching(&self, _i: u32) {}
+    /// The next event after [`Entries::approaching`]: what that asked for is at hand (a hint to
+    /// start loading what it leads to, such as the balls in the cells it asked for).
+    fn imminent(&self, _i: u32) {}
 }
 
 /// Up to four entries of a bucket in one cache line, and the chunk with its further entries.
@@ -170,6 +173,8 @@ pub struct Calendar {
     /// The entries of bucket `base`, opened but not yet sorted into live and dead: time, ball
     /// and entry.
     staged: Vec<(f64, u32, u32)>,
+    /// Balls announced as approaching at the last call of [`Calendar::first`].
+    approached: Vec<u32>,
     /// The chained chunks of bucket `base`, freed once it is sorted.
     staged_chunks: Vec<u32>,
     /// Calls to [`Calendar::first`] and insertions since the rate was last measured, and the
@@ -204,6 +209,7 @@ impl Calendar {
             marks: 0,
             staged: Vec::new(),
             staged_chunks: Vec::new(),
+            approached: Vec::new(),
             calls: 0,
             sets: 0,
             since: start,
@@ -335,6 +341,10 @@ impl Calendar {
     /// The ball with the earliest key, if any (it stays queued until it is set again).
     #[inline]
     pub fn first<E: Entries + ?Sized>(&mut self, e: &mut E) -> Option<u32> {
+        for &b in &self.approached {
+            e.imminent(b);
+        }
+        self.approached.clear();
         self.sort_staged(e);
         self.calls += 1;
         if self.calls >= (self.ring_len() as u64 / 16).max(1024) {
@@ -398,7 +408,9 @@ impl Calendar {
         loop {
             let chunk = self.chunks[c];
             for k in 0..chunk.len as usize {
-                e.opened(chunk.ball[k]);
+                if self.far {
+                    e.opened(chunk.ball[k]);
+                }
                 let entry = (c * PER_CHUNK + k) as u32;
                 self.staged.push((chunk.t[k], chunk.ball[k], entry));
             }
@@ -476,7 +488,10 @@ impl Calendar {
         for &(t, ball, entry) in &staged {
             if e.place(ball) == Place::ring(entry) {
                 self.in_ring -= 1;
-                e.approaching(ball);
+                if self.far {
+                    e.approaching(ball);
+                    self.approached.push(ball);
+                }
                 self.heap_push(e, Item { t, ball });
             }
         }

@@ -147,7 +147,25 @@ impl Entries for Queued<'_> {
             self.grid.prefetch_near(own.cross_cell);
         } else if let Partner::Ball(j, _) = own.phys.partner {
             prefetch(&self.slots[j as usize]);
-            prefetch(&self.own[j as usize]);
+            prefetch_all(&self.own[j as usize]);
+            self.grid.prefetch_near(self.slots[i as usize].cell);
+        }
+    }
+    /// The cells have arrived: start loading the slots of the balls in them.
+    #[inline]
+    fn imminent(&self, i: u32) {
+        let own = &self.own[i as usize];
+        let cell = self.slots[i as usize].cell;
+        if cell == NOT_ON_TABLE {
+            return;
+        }
+        if own.queued.path[..] == [CELL_CROSSING] {
+            self.grid
+                .for_each_entering(cell, own.cross_cell, |j| prefetch(&self.slots[j as usize]));
+        } else if let Partner::Ball(j, _) = own.phys.partner {
+            self.grid
+                .for_each_near(cell, |k| prefetch(&self.slots[k as usize]));
+            self.grid.prefetch_near(self.slots[j as usize].cell);
         }
     }
 }
@@ -403,10 +421,13 @@ impl EventList {
             prefetch(&self.slots[j as usize]);
             near.push(j);
         });
+        // copied before the cell is stored: a read of the whole slot right after a store into
+        // it would wait for that store (and every store before it) to reach the cache
+        let mut b = self.slots[i as usize];
+        b.cell = to;
         self.grid.remove_from(i, from);
         self.grid.insert(i, to);
         self.slots[i as usize].cell = to;
-        let b = self.slots[i as usize];
         let mut best = std::mem::replace(&mut self.own[i as usize].phys, Best::none());
         for &j in &near {
             self.offer_ball(i, &b, j, &mut best);
