@@ -6,11 +6,12 @@
 //! however many balls there are (the O(1) queue of G. Paul, J. Comput. Phys. 221, 2007). A
 //! tournament tree over a million balls costs some twenty cache misses per update instead.
 //!
-//! A bucket is one cache line holding the times and balls of up to four entries, with more
+//! A bucket is half a cache line holding the balls of up to six entries, with more
 //! chained to it in chunks of the same size, and an entry is removed lazily: moving a ball's
 //! event only forgets the entry it had (the ball's [`Place`] no longer names it), and the dead
-//! entry is dropped when its bucket comes up. So the calendar reads a ball's own record only to
-//! check its place, and to break a tie in time.
+//! entry is dropped when its bucket comes up. The calendar reads a ball's own record (its place
+//! and time) only when the ball's bucket is opened, and to break a tie in time; the heap and the
+//! overflow list keep the times of their entries.
 //!
 //! At a million balls the buckets and the balls' records are far apart in memory, and the queue
 //! is laid out so that no trip there stalls the engine:
@@ -43,16 +44,16 @@ const AHEAD: usize = 8;
 const PREFETCH_BUCKETS: i64 = 4;
 
 /// A ring larger than this many bytes is taken to be out of cache.
-const FAR_BYTES: usize = 4 << 20;
+const FAR_BYTES: usize = 1 << 20;
 
-/// Entries per chunk (one cache line).
-const PER_CHUNK: usize = 4;
+/// Entries per chunk (half a cache line).
+const PER_CHUNK: usize = 6;
 
 /// Entries (live or dead) a bucket should receive: most buckets then fit in their first chunk.
 /// The width is set again when the rate of insertions makes it stray out of [`FEW`, `MANY`].
-const TARGET: f64 = 2.0;
-const FEW: f64 = 0.5;
-const MANY: f64 = 4.0;
+const TARGET: f64 = 3.0;
+const FEW: f64 = 0.75;
+const MANY: f64 = 6.0;
 
 /// Ring places from this index on name entries not yet written into their buckets.
 const WAITING: u32 = 1 << 29;
@@ -112,18 +113,18 @@ pub trait Entries {
     fn imminent(&self, _i: u32) {}
 }
 
-/// Up to four entries of a bucket in one cache line, and the chunk with its further entries.
+/// Up to six entries of a bucket in half a cache line, and the chunk with its further entries.
+/// An entry is only a ball: its time is read from the ball's record, which is loaded anyway to
+/// check the entry.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
+#[repr(C, align(32))]
 struct Chunk {
-    t: [f64; PER_CHUNK],
     ball: [u32; PER_CHUNK],
     len: u32,
     more: u32,
 }
 
 const EMPTY: Chunk = Chunk {
-    t: [0.0; PER_CHUNK],
     ball: [0; PER_CHUNK],
     len: 0,
     more: NIL,
@@ -139,7 +140,6 @@ struct Item {
 /// An entry waiting to be written into its bucket.
 #[derive(Clone, Copy, Debug)]
 struct Waiting {
-    t: f64,
     ball: u32,
     slot: u32,
     /// The ball's place while it waits.
@@ -170,9 +170,9 @@ pub struct Calendar {
     far: bool,
     /// Counter of the marks of waiting entries.
     marks: u32,
-    /// The entries of bucket `base`, opened but not yet sorted into live and dead: time, ball
-    /// and entry.
-    staged: Vec<(f64, u32, u32)>,
+    /// The entries of bucket `base`, opened but not yet sorted into live and dead: ball and
+    /// entry.
+    staged: Vec<(u32, u32)>,
     /// Balls announced as approaching at the last call of [`Calendar::first`].
     approached: Vec<u32>,
     /// The chained chunks of bucket `base`, freed once it is sorted.
@@ -186,11 +186,12 @@ pub struct Calendar {
 
 impl Calendar {
     /// A calendar for `n` balls, starting at time `start`, whose events are about `mean_gap`
-    /// apart in time overall (a bucket is two mean gaps wide; the ring holds about `2n` buckets).
+    /// apart in time overall (a bucket is three mean gaps wide; the ring holds `2n` to `4n`
+    /// buckets).
     pub fn new(n: usize, start: f64, mean_gap: f64) -> Calendar {
         let buckets = (2 * n).next_power_of_two().clamp(16, 1 << 23);
         let width = if mean_gap.is_finite() && mean_gap > 0.0 {
-            2.0 * mean_gap
+            TARGET * mean_gap
         } else {
             1.0
         };
@@ -266,7 +267,6 @@ impl Calendar {
             e.set_place(i, Place::ring(mark));
             self.in_ring += 1;
             let w = Waiting {
-                t,
                 ball: i,
                 slot,
                 mark,
@@ -306,7 +306,6 @@ impl Calendar {
         }
         let chunk = &mut self.chunks[c];
         let k = chunk.len as usize;
-        chunk.t[k] = w.t;
         chunk.ball[k] = w.ball;
         chunk.len += 1;
         let entry = (c * PER_CHUNK + k) as u32;
@@ -412,7 +411,7 @@ impl Calendar {
                     e.opened(chunk.ball[k]);
                 }
                 let entry = (c * PER_CHUNK + k) as u32;
-                self.staged.push((chunk.t[k], chunk.ball[k], entry));
+                self.staged.push((chunk.ball[k], entry));
             }
             if c != slot as usize {
                 self.staged_chunks.push(c as u32);
@@ -485,8 +484,9 @@ impl Calendar {
     /// chunks (only here, so that a staged entry cannot be taken for a newer one).
     fn sort_staged<E: Entries + ?Sized>(&mut self, e: &mut E) {
         let mut staged = std::mem::take(&mut self.staged);
-        for &(t, ball, entry) in &staged {
+        for &(ball, entry) in &staged {
             if e.place(ball) == Place::ring(entry) {
+                let t = e.key(ball).t;
                 self.in_ring -= 1;
                 if self.far {
                     e.approaching(ball);
