@@ -44,7 +44,7 @@ const AHEAD: usize = 8;
 const PREFETCH_BUCKETS: i64 = 4;
 
 /// A ring larger than this many bytes is taken to be out of cache.
-const FAR_BYTES: usize = 1 << 20;
+const FAR_BYTES: usize = 64 << 10;
 
 /// Entries per chunk (half a cache line).
 const PER_CHUNK: usize = 6;
