@@ -146,8 +146,8 @@ struct Waiting {
     mark: u32,
 }
 
-/// The calendar queue. It stores ball indices and their times, and reaches the balls' records
-/// through [`Entries`] for their places and to break ties.
+/// The calendar queue. It stores ball indices (with their times in the heap and the overflow
+/// list), and reaches the balls' records through [`Entries`] for their places and times.
 #[derive(Clone, Debug)]
 pub struct Calendar {
     inv_width: f64,
