@@ -186,10 +186,10 @@ pub struct Calendar {
 
 impl Calendar {
     /// A calendar for `n` balls, starting at time `start`, whose events are about `mean_gap`
-    /// apart in time overall (a bucket is three mean gaps wide; the ring holds `2n` to `4n`
+    /// apart in time overall (a bucket is three mean gaps wide; the ring holds `4n` to `8n`
     /// buckets).
     pub fn new(n: usize, start: f64, mean_gap: f64) -> Calendar {
-        let buckets = (2 * n).next_power_of_two().clamp(16, 1 << 23);
+        let buckets = (4 * n).next_power_of_two().clamp(16, 1 << 23);
         let width = if mean_gap.is_finite() && mean_gap > 0.0 {
             TARGET * mean_gap
         } else {
