@@ -375,12 +375,8 @@ impl Calendar {
     /// the ring or the overflow list.
     fn advance<E: Entries + ?Sized>(&mut self, e: &mut E) -> bool {
         if self.in_ring == 0 {
-            let earliest = self
-                .overflow
-                .iter()
-                .enumerate()
-                .filter(|&(k, &(_, ball))| e.place(ball) == Place::overflow(k))
-                .map(|(_, &(t, _))| self.bucket(t))
+            let earliest = Self::live_overflow(&self.overflow, e)
+                .map(|(t, _)| self.bucket(t))
                 .min();
             let Some(earliest) = earliest else {
                 self.overflow.clear();
@@ -460,11 +456,7 @@ impl Calendar {
                 }
             }
         }
-        for (k, &(_, ball)) in self.overflow.iter().enumerate() {
-            if e.place(ball) == Place::overflow(k) {
-                live.push(ball);
-            }
-        }
+        live.extend(Self::live_overflow(&self.overflow, e).map(|(_, ball)| ball));
         // everything before the end of bucket `base` is opened, and stays so
         let opened_until = (self.base + 1) as f64 / self.inv_width;
         self.inv_width /= factor.clamp(1.0 / 64.0, 64.0);
@@ -505,13 +497,23 @@ impl Calendar {
         self.staged_chunks.clear();
     }
 
+    /// The entries of an overflow list that are still their balls' (time and ball).
+    fn live_overflow<'a, E: Entries + ?Sized>(
+        overflow: &'a [(f64, u32)],
+        e: &'a E,
+    ) -> impl Iterator<Item = (f64, u32)> + 'a {
+        overflow
+            .iter()
+            .enumerate()
+            .filter(move |&(k, &(_, ball))| e.place(ball) == Place::overflow(k))
+            .map(|(_, &entry)| entry)
+    }
+
     /// Moves the overflow entries that now fall within the ring into it.
     fn pull_overflow<E: Entries + ?Sized>(&mut self, e: &mut E) {
         let old = std::mem::take(&mut self.overflow);
-        for (k, &(t, ball)) in old.iter().enumerate() {
-            if e.place(ball) != Place::overflow(k) {
-                continue;
-            }
+        let live: Vec<(f64, u32)> = Self::live_overflow(&old, e).collect();
+        for (t, ball) in live {
             if self.bucket(t) - self.base < self.ring_len() {
                 e.set_place(ball, Place::NOWHERE);
                 self.insert(e, ball);
