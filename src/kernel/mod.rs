@@ -140,6 +140,9 @@ pub struct Pending<M> {
     pub to: u32,
     /// Its priority in the receiver's batch.
     pub priority: u8,
+    /// Whether its sender may cancel it (sent with [`Ctx::send_at`]); a relay is never looked up
+    /// among the cancellations.
+    pub retractable: bool,
     /// Sender, sequence and payload.
     pub env: Envelope<M>,
 }
@@ -213,12 +216,31 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
         &self.now
     }
 
-    /// Sends `msg` to `to` at virtual time `time`, which must not be before now.
+    /// Sends `msg` to `to` at virtual time `time`, which must not be before now; the handle
+    /// returned lets the sender cancel it.
     ///
     /// # Panics
     /// If `time` is not after now: a model bug, a message into the past (in a speculative
     /// batch the message is dropped and the batch marked instead).
     pub fn send_at(&mut self, to: u32, time: VTime, msg: M::Msg) -> Handle {
+        self.post(to, time, msg, true)
+    }
+
+    /// Sends `msg` to `to` at `time`, as [`Ctx::send_at`], as a message that is never cancelled
+    /// (a relay of news, as the thesis' NewVelocity and VelocityChange: 5.4), so that the
+    /// executor need not look it up among the cancellations.
+    pub fn relay_at(&mut self, to: u32, time: VTime, msg: M::Msg) {
+        self.post(to, time, msg, false);
+    }
+
+    /// Sends `msg` to `to` with zero delay, never to be cancelled: it arrives after this batch,
+    /// within the same key.
+    pub fn send_now(&mut self, to: u32, msg: M::Msg) {
+        let time = self.now.next_gen();
+        self.relay_at(to, time, msg);
+    }
+
+    fn post(&mut self, to: u32, time: VTime, msg: M::Msg, retractable: bool) -> Handle {
         if time <= self.now {
             let what = format!(
                 "object {} sent a message into the past: {:?} at {:?}",
@@ -242,17 +264,12 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             time,
             to,
             priority: self.model.priority(&env.msg),
+            retractable,
             env,
         };
         let h = p.handle();
         self.sent.push(p);
         h
-    }
-
-    /// Sends `msg` to `to` with zero delay: it arrives after this batch, within the same key.
-    pub fn send_now(&mut self, to: u32, msg: M::Msg) -> Handle {
-        let time = self.now.next_gen();
-        self.send_at(to, time, msg)
     }
 
     /// Retracts a message this object sent (one thesis Cancel message). Cancelling a message

@@ -97,7 +97,7 @@ impl<M: Model> Sequential<M> {
     /// Pops the next message that was not cancelled.
     fn pop_live(&mut self) -> Option<Pending<M::Msg>> {
         while let Some(Item(p)) = self.pending.pop() {
-            if !self.cancelled.remove(&p.handle()) {
+            if !(p.retractable && self.cancelled.remove(&p.handle())) {
                 return Some(p);
             }
         }
@@ -111,7 +111,8 @@ impl<M: Model> Sequential<M> {
     fn sweep_cancelled(&mut self) {
         if self.cancelled.len() > 1024 && 2 * self.cancelled.len() > self.pending.len() {
             let dead = &self.cancelled;
-            self.pending.retain(|Item(p)| !dead.contains(&p.handle()));
+            self.pending
+                .retain(|Item(p)| !(p.retractable && dead.contains(&p.handle())));
             self.cancelled.clear();
         }
     }

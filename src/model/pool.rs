@@ -314,7 +314,7 @@ impl Pool {
     ) {
         for to in targets {
             let time = self.nv_time(ctx, me, to);
-            ctx.send_at(to, time, PoolMsg::NewVelocity(info.clone()));
+            ctx.relay_at(to, time, PoolMsg::NewVelocity(info.clone()));
         }
     }
 
