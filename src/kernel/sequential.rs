@@ -41,6 +41,10 @@ pub struct Sequential<M: Model> {
     cancelled: FxHashSet<Handle>,
     stats: MessageStats,
     now: Option<VTime>,
+    /// Buffers kept from batch to batch: the batch, and what it sent and cancelled.
+    batch: Vec<Envelope<M::Msg>>,
+    sent: Vec<Pending<M::Msg>>,
+    retracted: Vec<Handle>,
 }
 
 impl<M: Model> Sequential<M> {
@@ -55,6 +59,9 @@ impl<M: Model> Sequential<M> {
             cancelled: FxHashSet::default(),
             stats: MessageStats::default(),
             now: None,
+            batch: Vec::new(),
+            sent: Vec::new(),
+            retracted: Vec::new(),
         };
         for me in 0..s.states.len() as u32 {
             let mut ctx = Ctx::new(&s.model, start.clone(), me, &mut s.seqs[me as usize]);
@@ -133,7 +140,8 @@ impl<M: Model> Sequential<M> {
                 return Ok(());
             }
             let (time, to) = (first.time, first.to);
-            let mut batch: Vec<Envelope<M::Msg>> = vec![first.env];
+            let mut batch = std::mem::take(&mut self.batch);
+            batch.push(first.env);
             while let Some(Item(p)) = self.pending.peek() {
                 if p.to != to || p.time != time {
                     break;
@@ -148,19 +156,24 @@ impl<M: Model> Sequential<M> {
             self.stats.batches += 1;
             self.stats.delivered += batch.len() as u64;
             let mut ctx = Ctx::new(&self.model, time.clone(), to, &mut self.seqs[to as usize]);
+            ctx.sent = std::mem::take(&mut self.sent);
+            ctx.cancelled = std::mem::take(&mut self.retracted);
             self.model
                 .handle(&mut ctx, to, &mut self.states[to as usize], &batch);
-            let (sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
-            for h in cancelled {
+            batch.clear();
+            self.batch = batch;
+            let (mut sent, mut cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
+            for h in cancelled.drain(..) {
                 self.stats.cancels += 1;
                 self.cancelled.insert(h);
             }
             self.sweep_cancelled();
-            for p in sent {
+            for p in sent.drain(..) {
                 self.stats.count(self.model.kind(&p.env.msg));
                 let in_instant = p.time.key == time.key;
                 self.pending.push(Item(p), in_instant);
             }
+            (self.sent, self.retracted) = (sent, cancelled);
             self.now = Some(time);
             for o in output {
                 sink(&self.model, &self.states, o)?;
