@@ -325,6 +325,8 @@ struct Sent {
     slot: Option<u32>,
     seq: u64,
     to: u32,
+    /// Whether its sender may cancel it: only those are filed once committed.
+    retractable: bool,
     time: VTime,
 }
 
@@ -537,16 +539,19 @@ impl<M: Model> Worker<M> {
                 let uid = lp.next_uid();
                 let slot = (self.placement.worker(p.to) == self.index)
                     .then(|| self.entries.reserve(uid).slot);
-                lp.sends.insert(
-                    p.env.seq,
-                    Sent {
-                        uid,
-                        slot,
-                        seq: p.env.seq,
-                        to: p.to,
-                        time: p.time.clone(),
-                    },
-                );
+                if p.retractable {
+                    lp.sends.insert(
+                        p.env.seq,
+                        Sent {
+                            uid,
+                            slot,
+                            seq: p.env.seq,
+                            to: p.to,
+                            retractable: true,
+                            time: p.time.clone(),
+                        },
+                    );
+                }
                 self.route(Op::Msg { uid, p }, slot);
             }
         }
@@ -761,6 +766,7 @@ impl<M: Model> Worker<M> {
                 slot,
                 seq: p.env.seq,
                 to: p.to,
+                retractable: p.retractable,
                 time: p.time.clone(),
             };
             sent_recs.push((s, model.kind(&p.env.msg) as u16));
@@ -956,7 +962,7 @@ impl<M: Model> Worker<M> {
                 for (s, kind) in d.sent {
                     cs.count(usize::from(kind));
                     // still ahead: it may yet be cancelled by a later batch
-                    if !gvt.passed(&s.time, s.to) {
+                    if s.retractable && !gvt.passed(&s.time, s.to) {
                         lp.sends.insert(s.seq, s);
                     }
                 }
