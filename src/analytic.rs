@@ -47,19 +47,33 @@ impl ModelParams {
     /// Checks the parameters: `N`, `V` and `T` finite and positive, `m` finite and not negative.
     /// The error names the command-line option.
     pub fn validate(&self) -> Result<(), String> {
-        for (name, x) in [
-            ("--balls", self.balls),
-            ("--speed", self.speed),
-            ("--time", self.time),
-        ] {
+        if !(self.balls >= 1.0 && self.balls <= MAX_BALLS && self.balls.fract() == 0.0) {
+            return Err(format!(
+                "--balls must be a whole number from 1 to {MAX_BALLS:e}, got {:?}",
+                self.balls
+            ));
+        }
+        for (name, x) in [("--speed", self.speed), ("--time", self.time)] {
             if !(x.is_finite() && x > 0.0) {
-                return Err(format!("{name} must be a positive number, got {x}"));
+                return Err(format!("{name} must be a positive number, got {x:?}"));
             }
         }
         if !(self.changes.is_finite() && self.changes >= 0.0) {
             return Err(format!(
                 "--changes must be a number not below 0, got {}",
                 self.changes
+            ));
+        }
+        // F is largest at the ends of the widths reported: one sector, and the finest grid
+        let finest = 1.0
+            / (4.0 * self.balls.sqrt() / (2.0 * 2f64.sqrt()))
+                .ceil()
+                .max(8.0);
+        if !(messages(self, 1.0).is_finite() && messages(self, finest).is_finite()) {
+            return Err(format!(
+                "the message counts overflow a 64-bit float for N = {:?}, V = {:?}, T = {:?}, \
+                 m = {:?}",
+                self.balls, self.speed, self.time, self.changes
             ));
         }
         Ok(())
@@ -74,6 +88,9 @@ impl ModelParams {
         }
     }
 }
+
+/// The most balls the model takes: its table of grids then stays at a few dozen rows.
+pub const MAX_BALLS: f64 = 1e15;
 
 /// The model's message count for sectors of width `s` (thesis ch. 7, equations 1 and 2):
 /// `F(s) = (N V T / s)(N s² + 8) + m (N s² + 15)`. Meaningful for `0 < s ≤ 1`.

@@ -246,6 +246,31 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     if a.repeat == 0 {
         return Err("--repeat: must be at least 1".into());
     }
+    for (flag, counts) in [
+        ("--balls", &a.balls),
+        ("--objects-balls", &a.objects_balls),
+        ("--sectored-balls", &a.sectored_balls),
+        ("--tw-balls", &a.tw_balls),
+    ] {
+        if counts.contains(&0) {
+            return Err(format!("{flag}: each ball count must be at least 1"));
+        }
+    }
+    if a.events == 0 {
+        return Err("--events: must be at least 1".into());
+    }
+    if a.phold_objects < 2 {
+        return Err(format!(
+            "--phold-objects: PHOLD runs on two partitions, so it needs at least 2 objects, got {}",
+            a.phold_objects
+        ));
+    }
+    if !(a.cell_diameters.is_finite() && a.cell_diameters >= 1.0) {
+        return Err(format!(
+            "--cell-diameters: a cell must be at least one ball diameter wide, got {:?}",
+            a.cell_diameters
+        ));
+    }
     if !(a.tw_until.is_finite() && a.tw_until > 0.0) {
         return Err(format!(
             "--tw-until: must be a positive simulated time, got {}",

@@ -320,6 +320,9 @@ struct PholdArgs {
     json: bool,
 }
 
+/// The most PHOLD events in flight (objects times events per object): about a gigabyte.
+const MAX_PHOLD_EVENTS: u64 = 10_000_000;
+
 fn phold(a: &PholdArgs) -> Result<(), Failure> {
     use poolsim::model::phold::{run, PholdConfig};
     let positive = |flag: &str, v: f64| {
@@ -363,6 +366,13 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
         Some(c) => poolsim::kernel::time_warp::threads::total_workers(c) as u32,
         None => 2,
     });
+    if u64::from(a.objects) * u64::from(a.events_per_object) > MAX_PHOLD_EVENTS {
+        return Err(usage(format!(
+            "--objects x --events-per-object: at most {MAX_PHOLD_EVENTS} events in flight, got \
+             {} x {}",
+            a.objects, a.events_per_object
+        )));
+    }
     if a.objects == 0 || partitions == 0 || partitions > a.objects {
         return Err(usage(format!(
             "--objects and --partitions: need 1 <= partitions <= objects, got {} and {}",
@@ -534,24 +544,34 @@ fn nv_delay(arg: Option<&str>, s: &Scenario) -> Result<NvDelay, Failure> {
 /// `--sectors`: none, auto, N (N x N) or NxM; absent means the scenario's own `[sectors]`, if
 /// any.
 fn sector_choice(arg: Option<&str>, s: &Scenario) -> Result<Option<SectorChoice>, Failure> {
-    let bad = |text: &str| {
+    let bad = || {
         usage(format!(
-            "--sectors: expected none, auto, N or NxM (sectors per side), got `{text}`"
+            "--sectors: expected none, auto, N or NxM (sectors per side, at least 1 each, at most \
+             {} sectors in all), got `{}`",
+            scenario::MAX_SECTORS,
+            arg.unwrap_or_default()
         ))
     };
     let count = |text: &str| match text.parse::<u32>() {
-        Ok(n) if (1..=10_000).contains(&n) => Ok(n),
-        _ => Err(bad(text)),
+        Ok(n) if n >= 1 && u64::from(n) <= scenario::MAX_SECTORS => Ok(n),
+        _ => Err(bad()),
+    };
+    let grid = |nx: u32, ny: u32| {
+        if u64::from(nx) * u64::from(ny) > scenario::MAX_SECTORS {
+            Err(bad())
+        } else {
+            Ok(Some(SectorChoice::Grid(nx, ny)))
+        }
     };
     Ok(match arg {
         None => s.sectors.as_ref().map(|_| SectorChoice::Scenario),
         Some("none") => None,
         Some("auto") => Some(SectorChoice::Auto),
         Some(text) => match text.split_once(['x', 'X']) {
-            Some((nx, ny)) => Some(SectorChoice::Grid(count(nx)?, count(ny)?)),
+            Some((nx, ny)) => grid(count(nx)?, count(ny)?)?,
             None => {
                 let n = count(text)?;
-                Some(SectorChoice::Grid(n, n))
+                grid(n, n)?
             }
         },
     })
@@ -977,17 +997,54 @@ fn die_quietly_on_closed_pipe() {
     }
 }
 
+/// Parses the command line; every subcommand takes negative numbers as values, so that a
+/// negative value is reported by the check of its option, not as an unknown option.
+fn parse_command_line() -> Result<Cli, clap::Error> {
+    use clap::{CommandFactory, FromArgMatches};
+    let mut cmd = Cli::command();
+    let names: Vec<String> = cmd
+        .get_subcommands()
+        .map(|s| s.get_name().to_string())
+        .collect();
+    for name in names {
+        cmd = cmd.mut_subcommand(name, |s| s.allow_negative_numbers(true));
+    }
+    Cli::from_arg_matches(&cmd.try_get_matches()?)
+}
+
+/// One line for a usage error: clap's first paragraph (the problem, with the arguments it names
+/// and the possible values), without its usage and help hints.
+fn usage_line(e: &clap::Error) -> String {
+    use clap::error::ErrorKind;
+    if matches!(
+        e.kind(),
+        ErrorKind::MissingSubcommand | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        return "no command given (try `poolsim --help`)".to_string();
+    }
+    let text = e.to_string();
+    let first: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.trim().is_empty())
+        .map(str::trim)
+        .collect();
+    let line = first.join(" ");
+    let line = line.trim_start_matches("error: ");
+    if line.is_empty() {
+        "bad usage".to_string()
+    } else {
+        line.to_string()
+    }
+}
+
 fn main() -> ExitCode {
     keep_freed_memory();
     die_quietly_on_closed_pipe();
-    let cli = match Cli::try_parse() {
+    let cli = match parse_command_line() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => e.exit(), // --help, --version
         Err(e) => {
-            // one line, as for every other bad input
-            let text = e.to_string();
-            let first = text.lines().next().unwrap_or("bad usage");
-            eprintln!("poolsim: {}", first.trim_start_matches("error: "));
+            eprintln!("poolsim: {}", usage_line(&e));
             return ExitCode::from(2);
         }
     };

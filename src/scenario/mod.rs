@@ -11,6 +11,11 @@ pub mod toml;
 use crate::geometry::Vec2;
 use std::fmt;
 
+/// The most sectors a grid given by hand may have: 500 × 500. A sector costs its polygon, its
+/// neighbours and an object, so a grid of 500 × 500 already takes seconds to set up, and one of
+/// 10^4 × 10^4 gigabytes (`--sectors auto` keeps to about eight balls per sector instead).
+pub const MAX_SECTORS: u64 = 250_000;
+
 /// A ball at time 0.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BallSpec {
@@ -360,6 +365,11 @@ impl Scenario {
                     Err(invalid(
                         "sectors.grid".into(),
                         format!("needs at least one sector per side, got [{nx}, {ny}]"),
+                    ))
+                } else if u64::from(*nx) * u64::from(*ny) > MAX_SECTORS {
+                    Err(invalid(
+                        "sectors.grid".into(),
+                        format!("at most {MAX_SECTORS} sectors, got [{nx}, {ny}]"),
                     ))
                 } else {
                     Ok(())
