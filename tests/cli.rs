@@ -750,3 +750,53 @@ fn a_closed_pipe_ends_the_run_quietly() {
         assert_ne!(out.status.code(), Some(101), "{args:?}: {err}");
     }
 }
+
+/// A ball wedged between two cushions exactly its diameter apart bounces at one instant forever:
+/// every engine with instants stops with one clear line and exit status 1, and fast.
+#[test]
+fn a_wedged_ball_stops_every_engine_with_a_cascade_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("wedge.toml");
+    std::fs::write(
+        &p,
+        "[run]\nuntil = 1.0\n\
+         [[ball]]\nposition = [10.0, 200.0]\nvelocity = [5.0, 0.0]\nradius = 10.0\n\
+         [[cushion]]\nfrom = [0.0, 0.0]\nto = [0.0, 400.0]\n\
+         [[cushion]]\nfrom = [0.0, 400.0]\nto = [20.0, 400.0]\n\
+         [[cushion]]\nfrom = [20.0, 400.0]\nto = [20.0, 0.0]\n\
+         [[cushion]]\nfrom = [20.0, 0.0]\nto = [0.0, 0.0]\n",
+    )
+    .unwrap();
+    let p = p.to_str().unwrap();
+    for engine in [
+        &["--engine", "event-list"][..],
+        &["--engine", "objects"],
+        &["--engine", "objects", "--sectors", "2"],
+        &["--engine", "time-warp", "--workers", "2"],
+        &["--engine", "time-warp", "--workers", "2", "--sectors", "2"],
+    ] {
+        let args: Vec<&str> = ["run", p].iter().chain(engine).copied().collect();
+        let line = failure(&args, 1);
+        assert!(
+            line.contains("t = 0") && line.contains("does not end"),
+            "{line}"
+        );
+    }
+}
+
+/// Usage errors name what is missing or wrong on their one line, negative numbers included.
+#[test]
+fn usage_errors_say_what_is_wrong_on_one_line() {
+    assert!(bad_usage(&["render", "plate1"]).contains("--out"));
+    assert!(bad_usage(&["model"]).contains("--balls"));
+    assert!(bad_usage(&[]).contains("no command"));
+    assert!(bad_usage(&["experiment", "bogus", "--out", "x"]).contains("thesis, reversal"));
+    assert!(bad_usage(&["phold", "--remote", "-0.5"]).contains("-0.5"));
+    assert!(bad_usage(&["model", "--balls", "1e40"]).contains("--balls"));
+    assert!(bad_usage(&["model", "--balls", "36", "--time", "1e308"]).contains("overflow"));
+    assert!(
+        bad_usage(&["run", "gas", "--engine", "objects", "--sectors", "1000"]).contains("250000")
+    );
+    assert!(bad_usage(&["bench", "--phold-objects", "1"]).contains("--phold-objects"));
+    assert!(bad_usage(&["phold", "--objects", "4294967295"]).contains("events in flight"));
+}

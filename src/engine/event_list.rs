@@ -26,8 +26,8 @@ use super::calendar::{Calendar, Entries, Place};
 use super::grid::Grid;
 use super::prefetch::{prefetch, prefetch_all};
 use super::{
-    BallState, Event, EventCounts, EventKind, Fixed, Frame, Observer, Outcome, RunError, Span,
-    Table, World,
+    BallState, Event, EventCounts, EventKind, Fixed, Frame, InstantCap, Observer, Outcome,
+    RunError, Span, Table, World,
 };
 use crate::geometry::Trajectory;
 use crate::physics::{self, Contact};
@@ -39,9 +39,6 @@ use std::cmp::Ordering;
 /// The pair code that marks a ball leaving its cell: sorts after every physical event of its
 /// instant (a crossing changes no trajectory, so its place within the instant does not matter).
 const CELL_CROSSING: Pair = u64::MAX;
-
-/// The most events one instant may hold before the run stops with [`RunError::Cascade`].
-pub const MAX_EVENTS_PER_INSTANT: u64 = 10_000_000;
 
 /// A ball's earliest predicted physical event (or the best candidate so far while predicting).
 #[derive(Clone, Debug)]
@@ -199,6 +196,8 @@ pub struct EventList {
     /// Frames drawn so far.
     frames: u64,
     stats: Stats,
+    /// Stops an instant that never ends.
+    instant: InstantCap,
 }
 
 /// Options of the event-list engine.
@@ -265,6 +264,7 @@ impl EventList {
             span: opts.span,
             frames: 0,
             stats: Stats::default(),
+            instant: InstantCap::new(n),
         };
         // First predictions go into a provisional calendar; the real one's bucket width comes
         // from the mean time to each ball's first event (events then come about mean / n apart).
@@ -496,7 +496,6 @@ impl EventList {
         obs: &mut dyn Observer,
     ) -> Result<Outcome, RunError> {
         let mut counts = EventCounts::default();
-        let mut instant = (f64::NAN, 0u64);
         let mut until = until;
         loop {
             if counts.total() >= max_events {
@@ -599,17 +598,6 @@ impl EventList {
                     self.emit(&key, kind, i, f, &mut counts, obs)?;
                 }
             }
-            if instant.0 == key.t {
-                instant.1 += 1;
-                if instant.1 > MAX_EVENTS_PER_INSTANT {
-                    return Err(RunError::Cascade {
-                        t: key.t,
-                        events: MAX_EVENTS_PER_INSTANT,
-                    });
-                }
-            } else {
-                instant = (key.t, 1);
-            }
         }
         self.now = self.now.max(until);
         Ok(Outcome {
@@ -678,15 +666,14 @@ impl EventList {
     ) -> Result<(), RunError> {
         counts.add(kind);
         self.stats.max_depth = self.stats.max_depth.max(key.depth());
-        obs.on_event(
-            &Event {
-                t: key.t,
-                kind,
-                a,
-                b,
-            },
-            self,
-        )
+        let ev = Event {
+            t: key.t,
+            kind,
+            a,
+            b,
+        };
+        self.instant.count(&ev)?;
+        obs.on_event(&ev, self)
     }
 
     /// Every ball's state fixed at time `t` (not before the last event).

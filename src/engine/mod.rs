@@ -384,14 +384,71 @@ pub enum RunError {
     TimeWarp(String),
 }
 
+/// Counts the physical events of the current instant and stops a run whose instant never ends,
+/// such as a ball wedged between two cushions exactly a diameter apart, which bounces at one time
+/// forever. Each event of a cascade lengthens its key, so a chain must be stopped early: the
+/// cap is 1,000 events of one ball in one instant (a ball of a racked break takes part in a few),
+/// and 20,000 events plus 100 per ball in all.
+pub struct InstantCap {
+    t: f64,
+    events: u64,
+    cap: u64,
+    n_balls: u32,
+    /// Events of each ball in this instant, kept only while the instant has more than one.
+    per_ball: rustc_hash::FxHashMap<u32, u32>,
+}
+
+/// The most events one ball may take part in within one instant.
+const MAX_BALL_EVENTS_PER_INSTANT: u32 = 1_000;
+
+impl InstantCap {
+    /// The cap for a table of `n_balls` balls.
+    pub fn new(n_balls: usize) -> InstantCap {
+        InstantCap {
+            t: f64::NAN,
+            events: 0,
+            cap: 20_000 + 100 * n_balls as u64,
+            n_balls: n_balls as u32,
+            per_ball: Default::default(),
+        }
+    }
+
+    /// Counts event `ev`; an error once its instant holds more than the cap.
+    pub fn count(&mut self, ev: &Event) -> Result<(), RunError> {
+        if ev.t != self.t {
+            (self.t, self.events) = (ev.t, 1);
+            if !self.per_ball.is_empty() {
+                self.per_ball.clear();
+            }
+            return Ok(());
+        }
+        self.events += 1;
+        let mut over = self.events > self.cap;
+        for ball in [ev.a, ev.b] {
+            if ball < self.n_balls {
+                let n = self.per_ball.entry(ball).or_insert(1);
+                *n += 1;
+                over |= *n > MAX_BALL_EVENTS_PER_INSTANT;
+            }
+        }
+        if over {
+            return Err(RunError::Cascade {
+                t: ev.t,
+                events: self.events,
+            });
+        }
+        Ok(())
+    }
+}
+
 impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             RunError::Violation(m) => write!(f, "check failed: {m}"),
             RunError::Cascade { t, events } => write!(
                 f,
-                "more than {events} events at the single instant t = {t}: a cascade of \
-                 instantaneous collisions that does not end"
+                "{events} events at the single instant t = {t}: a cascade of instantaneous \
+                 collisions that does not end (a ball wedged between cushions or balls?)"
             ),
             RunError::Output(m) => write!(f, "output failed: {m}"),
             RunError::Input(m) => write!(f, "{m}"),

@@ -3,7 +3,8 @@
 //! Warp. With zero NewVelocity delay it executes exactly the event-list engine's physical events.
 
 use super::{
-    partition, BallState, EventCounts, Frame, Observer, Outcome, RunError, Span, Table, World,
+    partition, BallState, EventCounts, Frame, InstantCap, Observer, Outcome, RunError, Span, Table,
+    World,
 };
 use crate::kernel::sequential::{Sequential, Sink};
 use crate::kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
@@ -221,10 +222,12 @@ impl Objects {
             Objects::Plain(e) => run_plain(e, until, obs),
             Objects::Sectored(e) => {
                 let mut counts = EventCounts::default();
+                let mut instant = InstantCap::new(e.model().table().n_balls as usize);
                 e.run(
                     until,
                     obs.reads_balls(),
                     &mut |model: &Sectored, states, ev| {
+                        instant.count(&ev)?;
                         counts.add(ev.kind);
                         let view = View {
                             table: model.table(),
@@ -294,11 +297,13 @@ fn run_plain(
         let n = exec.model().table().n_balls as usize;
         // A frame is complete when every ball has drawn itself for it.
         let mut frame: Option<Frame> = None;
+        let mut instant = InstantCap::new(n);
         exec.run(
             until,
             obs.reads_balls(),
             &mut |model: &Pool, states, out| match out {
                 PoolOutput::Event(ev) => {
+                    instant.count(&ev)?;
                     counts.add(ev.kind);
                     let view = View {
                         table: model.table(),

@@ -52,6 +52,12 @@ use rustc_hash::FxHashMap;
 use std::cmp::Ordering;
 use std::collections::VecDeque;
 
+/// The deepest key (cascade of immediate events at one instant) Time Warp runs: its GVT does not
+/// tell keys apart past a few steps, so an instant this deep cannot commit, and one that never
+/// ends would fill memory (each step copies the key into every message it sends). The sequential
+/// engines stop a ball's instant at 1,000 events too.
+pub const MAX_CASCADE_DEPTH: usize = 1_000;
+
 /// Time Warp's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TwConfig {
@@ -749,6 +755,14 @@ impl<M: Model> Worker<M> {
             lp.last_time().is_none_or(|t| *t < time),
             "batches run in order"
         );
+        if time.key.depth() > MAX_CASCADE_DEPTH {
+            // GVT cannot pass an instant this deep, so it would pile up batches until memory ran out
+            self.fault.get_or_insert(format!(
+                "a cascade of zero-delay events at t = {} is over {MAX_CASCADE_DEPTH} steps deep \
+                 and does not end (a ball wedged between cushions or balls?)",
+                time.t()
+            ));
+        }
         let pre_state = lp.state.clone();
         let pre_seq = lp.seq;
         let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq);
