@@ -223,6 +223,12 @@ pub fn execute(
             out
         }
     };
+    if let (Some(c), false) = (
+        &mut sinks.checker,
+        matches!(cfg.engine, EngineKind::EventList),
+    ) {
+        c.sweep_final(&table, &outcome.balls, outcome.t)?;
+    }
     let wall = start.elapsed().as_secs_f64();
     let (e0, _) = energies(&initial);
     let (e1, ep) = energies(&outcome.balls);

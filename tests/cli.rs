@@ -800,3 +800,29 @@ fn usage_errors_say_what_is_wrong_on_one_line() {
     assert!(bad_usage(&["bench", "--phold-objects", "1"]).contains("--phold-objects"));
     assert!(bad_usage(&["phold", "--objects", "4294967295"]).contains("events in flight"));
 }
+
+/// `--check` also checks the state the run ends in: with a NewVelocity delay longer than the
+/// run, balls pass through each other without a single event, and the check must still fail.
+#[test]
+fn check_catches_what_no_event_shows() {
+    let line = failure(
+        &[
+            "run",
+            "gas",
+            "--balls",
+            "16",
+            "--until",
+            "2",
+            "--engine",
+            "objects",
+            "--newvelocity-delay",
+            "3",
+            "--check",
+        ],
+        1,
+    );
+    assert!(
+        line.contains("check failed") && line.contains("t = 2"),
+        "{line}"
+    );
+}

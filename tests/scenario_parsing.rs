@@ -236,3 +236,47 @@ fn builtins_survive_a_round_trip_through_toml() {
         assert_eq!(back, s, "{name}");
     }
 }
+
+const SQUARE: &str = "[[cushion]]\nfrom = [0.0, 0.0]\nto = [0.0, 400.0]\n\
+[[cushion]]\nfrom = [0.0, 400.0]\nto = [400.0, 400.0]\n\
+[[cushion]]\nfrom = [400.0, 400.0]\nto = [400.0, 0.0]\n\
+[[cushion]]\nfrom = [400.0, 0.0]\nto = [0.0, 0.0]\n";
+
+fn ball_at(x: f64, y: f64) -> String {
+    format!("[[ball]]\nposition = [{x:?}, {y:?}]\nvelocity = [500.0, 0.0]\nradius = 10.0\n")
+}
+
+/// Cushions wound the wrong way would let every ball through them: rejected at load.
+#[test]
+fn counter_clockwise_cushions_are_rejected() {
+    assert!(parse(&(ball_at(100.0, 100.0) + SQUARE), SOURCE).is_ok());
+    let reversed: String = SQUARE
+        .replace("from", "FROM")
+        .replace("to =", "from =")
+        .replace("FROM", "to");
+    let e = parse(&(ball_at(100.0, 100.0) + &reversed), SOURCE).unwrap_err();
+    assert_eq!(e.field, "cushion[1]");
+    assert!(e.message.contains("counter-clockwise"), "{e}");
+}
+
+/// A ball inside the box of a closed table but outside the region its cushions enclose.
+#[test]
+fn a_ball_outside_a_closed_triangle_is_rejected() {
+    let triangle = "[[cushion]]\nfrom = [0.0, 0.0]\nto = [0.0, 400.0]\n\
+        [[cushion]]\nfrom = [0.0, 400.0]\nto = [400.0, 0.0]\n\
+        [[cushion]]\nfrom = [400.0, 0.0]\nto = [0.0, 0.0]\n";
+    assert!(parse(&(ball_at(100.0, 100.0) + triangle), SOURCE).is_ok());
+    let e = parse(&(ball_at(350.0, 350.0) + triangle), SOURCE).unwrap_err();
+    assert_eq!(e.field, "ball[1].position");
+    assert!(e.message.contains("outside the table"), "{e}");
+}
+
+/// Sector polygons are checked whatever engine will run, with the line of the polygon blamed.
+#[test]
+fn overlapping_sector_polygons_are_rejected_at_load() {
+    let sectors = "[[sectors.polygon]]\npoints = [[0.0, 0.0], [0.0, 400.0], [300.0, 400.0], [300.0, 0.0]]\n\
+        [[sectors.polygon]]\npoints = [[200.0, 0.0], [200.0, 400.0], [400.0, 400.0], [400.0, 0.0]]\n";
+    let e = parse(&(ball_at(100.0, 100.0) + SQUARE + sectors), SOURCE).unwrap_err();
+    assert_eq!(e.field, "sectors.polygon[1]");
+    assert!(e.line.is_some(), "{e}");
+}

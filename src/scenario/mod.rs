@@ -317,14 +317,77 @@ impl Scenario {
         Ok(())
     }
 
+    /// The table's edges: every cushion and pocket mouth, each going clockwise (the table on its
+    /// right).
+    fn edges(&self) -> Vec<(Vec2, Vec2)> {
+        self.cushions
+            .iter()
+            .map(|c| (c.from, c.to))
+            .chain(self.pockets.iter().map(|p| (p.from, p.to)))
+            .collect()
+    }
+
+    /// Cushions and pockets must run clockwise around the table (DESIGN.md: the table lies on the
+    /// right going from `from` to `to`): their signed area about their centre must not be
+    /// positive. Otherwise a ball meets each cushion from behind and passes through it.
+    fn check_winding(&self) -> Result<(), Invalid> {
+        let edges = self.edges();
+        let n = 2.0 * edges.len() as f64;
+        let centre = edges
+            .iter()
+            .fold(Vec2::ZERO, |acc, &(a, b)| acc + (1.0 / n) * (a + b));
+        let (lo, hi) = self.bounds();
+        let size = (hi - lo).norm();
+        let area: f64 = edges
+            .iter()
+            .map(|&(a, b)| 0.5 * (a - centre).cross(b - centre))
+            .sum();
+        if area > 1e-9 * size * size {
+            return Err(invalid(
+                "cushion[1]".into(),
+                "the cushions run counter-clockwise: the table must lie on the right of each \
+                 cushion going from `from` to `to` (swap every from and to)"
+                    .into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The table's edges if they close into loops (every edge ends where another begins); `None`
+    /// where they leave gaps: an open table has no inside to check balls against.
+    fn closed_edges(&self) -> Option<Vec<(Vec2, Vec2)>> {
+        let edges = self.edges();
+        let (lo, hi) = self.bounds();
+        let tol = 1e-9 * (hi - lo).norm();
+        let closed = edges.len() >= 3
+            && edges.len() <= 4096
+            && edges
+                .iter()
+                .all(|&(_, to)| edges.iter().any(|&(from, _)| (from - to).norm() <= tol));
+        closed.then_some(edges)
+    }
+
     fn check_on_table(&self) -> Result<(), Invalid> {
         if self.cushions.is_empty() && self.pockets.is_empty() {
             return Ok(());
         }
+        self.check_winding()?;
         let (lo, hi) = self.bounds();
+        let loops = self.closed_edges();
         for (i, b) in self.balls.iter().enumerate() {
             let p = b.position;
-            let inside_box = p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y;
+            if inside_box(p, lo, hi) && loops.as_ref().is_some_and(|e| !encloses(e, p)) {
+                return Err(invalid(
+                    format!("ball[{}].position", i + 1),
+                    format!(
+                        "Ball-{} at [{}, {}] is outside the table its cushions enclose",
+                        i + 1,
+                        p.x,
+                        p.y
+                    ),
+                ));
+            }
+            let inside_box = inside_box(p, lo, hi);
             let through_cushion = self.cushions.iter().position(|c| {
                 let l = c.to - c.from;
                 let len = l.norm();
@@ -385,10 +448,42 @@ impl Scenario {
                         check_vec(&f, *p)?;
                     }
                 }
-                Ok(())
+                // the layout must cover the table without overlaps whichever engine runs
+                let mut shapes = Vec::with_capacity(polys.len());
+                for (i, poly) in polys.iter().enumerate() {
+                    let f = format!("sectors.polygon[{}].points", i + 1);
+                    shapes.push(
+                        crate::polygon::Polygon::new(poly.clone()).map_err(|e| invalid(f, e))?,
+                    );
+                }
+                let (lo, hi) = self.bounds();
+                crate::polygon::validate_layout(&shapes, lo, hi).map_err(|e| {
+                    // blame the first polygon the message names, for its line in the file
+                    let field = e
+                        .find("sectors.polygon[")
+                        .and_then(|at| e[at..].find(']').map(|end| e[at..=at + end].to_string()))
+                        .unwrap_or_else(|| "sectors".into());
+                    invalid(field, e)
+                })
             }
         }
     }
+}
+
+/// Whether closed loops of `edges` enclose `p` (even-odd rule: a ray towards +x crosses them an
+/// odd number of times from inside).
+fn encloses(edges: &[(Vec2, Vec2)], p: Vec2) -> bool {
+    let crossings = edges
+        .iter()
+        .filter(|&&(a, b)| {
+            (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x)
+        })
+        .count();
+    crossings % 2 == 1
+}
+
+fn inside_box(p: Vec2, lo: Vec2, hi: Vec2) -> bool {
+    p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y
 }
 
 fn pts_empty(lo: Vec2) -> bool {
