@@ -252,8 +252,7 @@ fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
         quiet: true,
     };
     let engine = engine_of(&run_args, &scenario)?;
-    let r = poolsim::run::reverse(&scenario, engine, a.quit, a.check)
-        .map_err(|e| internal(e.to_string()))?;
+    let r = poolsim::run::reverse(&scenario, engine, a.quit, a.check).map_err(run_failure)?;
     if a.json {
         println!(
             "{}",
@@ -577,6 +576,14 @@ fn sector_choice(arg: Option<&str>, s: &Scenario) -> Result<Option<SectorChoice>
     })
 }
 
+/// A run's failure: bad input (exit 2) or the run's own (exit 1).
+fn run_failure(e: RunError) -> Failure {
+    match e {
+        RunError::Input(m) => usage(m),
+        e => internal(e.to_string()),
+    }
+}
+
 fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
     match a.engine.as_str() {
         "event-list" => {
@@ -698,6 +705,45 @@ fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
     Ok(tw)
 }
 
+/// The trace and the final state must go to two files, neither of them the scenario: writing
+/// one would truncate the other.
+fn check_outputs_apart(a: &RunArgs) -> Result<(), Failure> {
+    // where a path points, resolved as far as it exists; devices such as /dev/null are shared
+    let resolved = |p: &std::path::Path| {
+        if p.exists() && !p.is_file() {
+            return None;
+        }
+        p.canonicalize().ok().or_else(|| {
+            let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+            let dir = dir.unwrap_or(std::path::Path::new("."));
+            Some(dir.canonicalize().ok()?.join(p.file_name()?))
+        })
+    };
+    let same = |x: &std::path::Path, y: &std::path::Path| {
+        resolved(x).is_some_and(|x| resolved(y) == Some(x))
+    };
+    let scenario = std::path::Path::new(&a.scenario);
+    for (flag, out) in [("--trace", &a.trace), ("--final-state", &a.final_state)] {
+        if let Some(out) = out {
+            if same(out, scenario) {
+                return Err(usage(format!(
+                    "{flag}: {} is the scenario file; writing it would destroy it",
+                    out.display()
+                )));
+            }
+        }
+    }
+    if let (Some(t), Some(f)) = (&a.trace, &a.final_state) {
+        if same(t, f) {
+            return Err(usage(format!(
+                "--trace and --final-state: both name {}; give two files",
+                t.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 fn run(a: &RunArgs) -> Result<(), Failure> {
     let scenario = load(&a.scenario, &a.gen)?;
     let engine = engine_of(a, &scenario)?;
@@ -729,6 +775,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
             return Err(usage(format!("{flag}: only the time-warp engine takes it")));
         }
     }
+    check_outputs_apart(a)?;
     let until = a.until.unwrap_or(scenario.until);
     if !until.is_finite() || until < 0.0 {
         return Err(usage(format!(
@@ -771,10 +818,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         t.finish()
             .map_err(|e| internal(format!("writing the trace failed: {e}")))?;
     }
-    let report = report.map_err(|e| match e {
-        RunError::Input(m) => usage(m),
-        e => internal(e.to_string()),
-    })?;
+    let report = report.map_err(run_failure)?;
     if !root {
         return Ok(());
     }
@@ -897,10 +941,7 @@ fn render_to(
     } else {
         None
     };
-    let rec = record(scenario, cfg).map_err(|e| match e {
-        RunError::Input(m) => usage(m),
-        e => internal(e.to_string()),
-    })?;
+    let rec = record(scenario, cfg).map_err(run_failure)?;
     let line = write(&rec, &out, rasterizer.as_ref()).map_err(|e| match e {
         RenderError::Io { .. } => usage(e.to_string()),
         e => internal(e.to_string()),

@@ -137,6 +137,9 @@ fn energies(balls: &[BallState]) -> (f64, f64) {
     (on_table, pocketed)
 }
 
+/// The most steps a time-step run may take (each one moves and tests every ball).
+pub const MAX_TIME_STEPS: f64 = 1e9;
+
 /// Forwards events to an optional checker, then to the caller's observer.
 struct Sinks<'a> {
     checker: Option<Checker>,
@@ -188,6 +191,14 @@ pub fn execute(
             out
         }
         EngineKind::TimeStep { dt } => {
+            let steps = (cfg.until - cfg.span.start) / dt;
+            if steps > MAX_TIME_STEPS {
+                return Err(RunError::Input(format!(
+                    "--dt: {dt:?} makes {steps:.3e} steps from {:?} to {:?}, more than the \
+                     {MAX_TIME_STEPS:e} the time-step engine takes",
+                    cfg.span.start, cfg.until
+                )));
+            }
             let mut e = TimeStep::new(scenario, time_step::Options { dt, span: cfg.span });
             e.run(cfg.until, &mut sinks)?
         }

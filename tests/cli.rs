@@ -826,3 +826,22 @@ fn check_catches_what_no_event_shows() {
         "{line}"
     );
 }
+
+/// An output never overwrites the scenario or the other output, and a time step too small to
+/// finish is refused before the run starts.
+#[test]
+fn outputs_that_would_destroy_inputs_and_endless_time_steps_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("s.toml");
+    std::fs::copy(manifest_dir().join("scenarios/grazing.toml"), &scenario).unwrap();
+    let s = scenario.to_str().unwrap();
+    assert!(bad_usage(&["run", s, "--trace", s]).contains("scenario file"));
+    let out = dir.path().join("out.json");
+    let o = out.to_str().unwrap();
+    assert!(bad_usage(&["run", s, "--trace", o, "--final-state", o]).contains("two files"));
+    assert!(std::fs::read_to_string(&scenario)
+        .unwrap()
+        .contains("[[ball]]"));
+    let line = bad_usage(&["run", s, "--engine", "time-step", "--dt", "1e-300"]);
+    assert!(line.contains("--dt") && line.contains("steps"), "{line}");
+}
