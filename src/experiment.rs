@@ -2861,6 +2861,18 @@ fn results_json(data: &Data, fs: &[Finding]) -> Value {
 /// unwritable directory, a missing font); files written before an error stay.
 pub fn run(args: &ExperimentArgs) -> Result<(), String> {
     if args.which == Which::Reversal {
+        if let Some(flag) = [
+            ("--seeds", args.seeds.is_some()),
+            ("--balls", args.balls.is_some()),
+        ]
+        .iter()
+        .find_map(|&(flag, given)| given.then_some(flag))
+        {
+            return Err(format!(
+                "{flag}: only the thesis experiment takes it (the reversal study has its own \
+                 scenarios and quitting times)"
+            ));
+        }
         let font = args
             .font
             .clone()

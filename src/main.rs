@@ -814,11 +814,21 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
     if let Some(p) = &progress {
         p.bar.finish_and_clear();
     }
+    // the trace is the run's only output written as it goes
+    let trace_failed = |e: &dyn std::fmt::Display| {
+        let path = a.trace.as_ref().map(|p| p.display().to_string());
+        usage(format!(
+            "{}: writing the trace failed: {e}",
+            path.unwrap_or_default()
+        ))
+    };
     if let Some(t) = trace {
-        t.finish()
-            .map_err(|e| internal(format!("writing the trace failed: {e}")))?;
+        t.finish().map_err(|e| trace_failed(&e))?;
     }
-    let report = report.map_err(run_failure)?;
+    let report = report.map_err(|e| match e {
+        RunError::Output(m) => trace_failed(&m),
+        e => run_failure(e),
+    })?;
     if !root {
         return Ok(());
     }

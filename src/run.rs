@@ -163,6 +163,26 @@ impl Observer for Sinks<'_> {
     }
 }
 
+/// Refuses a ball so fast that it crosses its own radius in less time than the run's clock can
+/// tell apart (10^4 units in the last place at the run's latest time): its events would pile up
+/// at times that round together, and the run would never end.
+fn check_time_resolution(scenario: &Scenario, cfg: &RunConfig) -> Result<(), RunError> {
+    let latest = cfg.until.abs().max(cfg.span.start.abs()).max(1.0);
+    let resolution = 1e4 * f64::EPSILON * latest;
+    for (i, b) in scenario.balls.iter().enumerate() {
+        let crossing = b.radius / b.velocity.norm();
+        if crossing < resolution {
+            return Err(RunError::Input(format!(
+                "ball[{}].velocity: Ball-{} crosses its radius in {crossing:e} time units, \
+                 below the {resolution:e} that times up to {latest:e} resolve",
+                i + 1,
+                i + 1
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Runs `scenario` as `cfg` says, passing every event to `obs`.
 pub fn execute(
     scenario: &Scenario,
@@ -170,6 +190,7 @@ pub fn execute(
     obs: &mut dyn Observer,
 ) -> Result<Report, RunError> {
     let start = Instant::now();
+    check_time_resolution(scenario, cfg)?;
     let initial = BallState::initial(scenario, cfg.span.start);
     let table = Table::new(scenario);
     let checker = cfg
