@@ -411,11 +411,18 @@ fn gas(p: &Params) -> Result<Scenario, Invalid> {
                      fraction that fits is {phi_max}"
                 ),
             ),
+            None if phi_max > 0.0 => bad(
+                RADIUS,
+                format!(
+                    "{r:?} is too large for {n} balls on the default {side} x {side} table; use \
+                     a smaller radius or {AREA} at most {phi_max}"
+                ),
+            ),
             None => bad(
                 RADIUS,
                 format!(
-                    "{r} is too large for {n} balls on the default {side} x {side} table; use a \
-                     smaller radius or {AREA} at most {phi_max}"
+                    "{r:?} is too large for {n} balls on the default {side} x {side} table; use \
+                     a smaller radius"
                 ),
             ),
         }
