@@ -494,6 +494,16 @@ fn pts_empty(lo: Vec2) -> bool {
 /// accepted by built-ins that use them; a file takes none.
 pub fn load(spec: &str, params: &builtin::Params) -> Result<Scenario, ScenarioError> {
     let is_builtin = builtin::list().iter().any(|(name, _)| *name == spec);
+    if is_builtin && std::path::Path::new(spec).is_file() {
+        return Err(ScenarioError {
+            source: spec.to_string(),
+            line: None,
+            field: String::new(),
+            message: format!(
+                "names both a built-in scenario and a file here; write ./{spec} for the file"
+            ),
+        });
+    }
     if is_builtin {
         return builtin::build(spec, params).map_err(|e| ScenarioError {
             source: format!("built-in scenario {spec}"),
