@@ -462,6 +462,13 @@ impl Output {
                     path.display()
                 ))
             }
+            _ if path.exists() && !path.is_dir() => {
+                return Err(format!(
+                    "--out: {} is a file, not a folder for the frames; name a folder, FILE.html \
+                     or FILE.gif",
+                    path.display()
+                ))
+            }
             _ => Output::Folder(path.to_path_buf()),
         })
     }
