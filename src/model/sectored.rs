@@ -234,10 +234,9 @@ const KIND_NAMES: [&str; 9] = [
 pub struct Passage {
     /// The ball.
     pub ball: u32,
-    /// Whether it is an entry (else a departure).
-    pub entry: bool,
-    /// The ball's trajectory it was computed from.
-    pub info: Arc<BallInfo>,
+    /// For an entry, the ball's trajectory it was computed from (relayed to the sector's balls
+    /// when the ball enters); `None` for a departure.
+    pub entry: Option<Arc<BallInfo>>,
     /// The message to the sector itself.
     pub own: Handle,
     /// The message to the ball.
@@ -265,8 +264,10 @@ pub enum SecState {
     },
     /// A sector.
     Sector {
-        /// Balls whose disks touch it, with their trajectories as last heard.
-        members: Vec<(u32, Arc<BallInfo>)>,
+        /// Balls whose disks touch it, with the version (fixing key) of their trajectories as
+        /// last heard: a key, not the trajectory, so that saving the state copies no shared
+        /// pointers.
+        members: Vec<(u32, Key)>,
         /// Entries and departures it scheduled.
         planned: Vec<Passage>,
     },
@@ -286,7 +287,7 @@ impl Sectored {
         let table = Table::new(s);
         let n = table.n_balls;
         let first_sector = n + table.n_fixed();
-        let mut members: Vec<Vec<(u32, Arc<BallInfo>)>> = vec![Vec::new(); layout.polys.len()];
+        let mut members: Vec<Vec<(u32, Key)>> = vec![Vec::new(); layout.polys.len()];
         let mut states: Vec<SecState> = Vec::new();
         for (i, b) in s.balls.iter().enumerate() {
             let info = Arc::new(BallInfo {
@@ -304,7 +305,7 @@ impl Sectored {
                 .touching(b.position, b.radius)
                 .into_iter()
                 .map(|k| {
-                    members[k as usize].push((i as u32, info.clone()));
+                    members[k as usize].push((i as u32, info.fixed.clone()));
                     first_sector + k
                 })
                 .collect();
@@ -661,16 +662,16 @@ impl Sectored {
         }
     }
 
-    /// Schedules ball `ball`'s entry into (or departure from) sector `me` at `time`.
+    /// Schedules ball `ball`'s entry into sector `me` (with the trajectory it was predicted from)
+    /// or its departure (`None`) at `time`.
     fn passage(
         ctx: &mut Ctx<'_, Sectored>,
         me: u32,
         ball: u32,
-        entry: bool,
+        entry: Option<Arc<BallInfo>>,
         time: VTime,
-        info: Arc<BallInfo>,
     ) -> Passage {
-        let msg = if entry {
+        let msg = if entry.is_some() {
             SecMsg::SectorEntry { ball, sector: me }
         } else {
             SecMsg::SectorDeparture { ball, sector: me }
@@ -680,7 +681,6 @@ impl Sectored {
         Passage {
             ball,
             entry,
-            info,
             own,
             other,
         }
@@ -702,7 +702,7 @@ impl Sectored {
         &self,
         ctx: &mut Ctx<'_, Sectored>,
         me: u32,
-        members: &[(u32, Arc<BallInfo>)],
+        members: &[(u32, Key)],
         planned: &mut Vec<Passage>,
         ball: u32,
         info: &Arc<BallInfo>,
@@ -719,7 +719,7 @@ impl Sectored {
                 } else {
                     now.next_gen()
                 };
-                let p = Self::passage(ctx, me, ball, false, time, info.clone());
+                let p = Self::passage(ctx, me, ball, None, time);
                 planned.push(p);
             }
         }
@@ -749,7 +749,7 @@ impl Sectored {
         &self,
         ctx: &mut Ctx<'_, Sectored>,
         me: u32,
-        members: &mut Vec<(u32, Arc<BallInfo>)>,
+        members: &mut Vec<(u32, Key)>,
         planned: &mut Vec<Passage>,
         batch: &[Envelope<SecMsg>],
     ) {
@@ -757,11 +757,14 @@ impl Sectored {
         for env in batch {
             match &env.msg {
                 SecMsg::SectorEntry { ball, .. } => {
-                    let Some(k) = planned.iter().position(|p| p.ball == *ball && p.entry) else {
+                    let Some(k) = planned
+                        .iter()
+                        .position(|p| p.ball == *ball && p.entry.is_some())
+                    else {
                         continue;
                     };
-                    let info = planned.swap_remove(k).info;
-                    members.push((*ball, info.clone()));
+                    let info = planned.swap_remove(k).entry.expect("an entry");
+                    members.push((*ball, info.fixed.clone()));
                     self.relay(ctx, me, members, planned, *ball, &info, None);
                 }
                 SecMsg::SectorDeparture { ball, .. } => {
@@ -770,8 +773,8 @@ impl Sectored {
                 }
                 SecMsg::VelocityChange { ball, info } => {
                     match members.iter().position(|m| m.0 == *ball) {
-                        Some(k) => members[k].1 = info.clone(),
-                        None => members.push((*ball, info.clone())),
+                        Some(k) => members[k].1 = info.fixed.clone(),
+                        None => members.push((*ball, info.fixed.clone())),
                     }
                     if info.pocket.is_some() {
                         members.retain(|m| m.0 != *ball);
@@ -784,8 +787,8 @@ impl Sectored {
                 SecMsg::NewVelocity { ball, info } => {
                     if let Some(k) = members.iter().position(|m| m.0 == *ball) {
                         // a member: only news (its course changed out of our sight) matters
-                        if info.fixed > members[k].1.fixed {
-                            members[k].1 = info.clone();
+                        if info.fixed > members[k].1 {
+                            members[k].1 = info.fixed.clone();
                             if info.pocket.is_some() {
                                 members.retain(|m| m.0 != *ball);
                             }
@@ -793,10 +796,9 @@ impl Sectored {
                         }
                         continue;
                     }
-                    if planned
-                        .iter()
-                        .any(|p| p.ball == *ball && p.entry && p.info.fixed == info.fixed)
-                    {
+                    if planned.iter().any(|p| {
+                        p.ball == *ball && p.entry.as_ref().is_some_and(|e| e.fixed == info.fixed)
+                    }) {
                         continue; // this entry is planned already
                     }
                     Self::cancel_passage(ctx, planned, *ball);
@@ -818,7 +820,7 @@ impl Sectored {
                         })
                     };
                     if let Some(time) = time {
-                        let p = Self::passage(ctx, me, *ball, true, time, info.clone());
+                        let p = Self::passage(ctx, me, *ball, Some(info.clone()), time);
                         planned.push(p);
                     }
                 }
