@@ -205,11 +205,7 @@ pub fn execute(
                 ..Default::default()
             };
             let mut e = EventList::new(scenario, opts);
-            let out = e.run(cfg.until, &mut sinks)?;
-            if let Some(c) = &mut sinks.checker {
-                c.sweep(&e, cfg.until.min(out.t))?;
-            }
-            out
+            e.run(cfg.until, &mut sinks)?
         }
         EngineKind::TimeStep { dt } => {
             let steps = (cfg.until - cfg.span.start) / dt;
@@ -255,10 +251,8 @@ pub fn execute(
             out
         }
     };
-    if let (Some(c), false) = (
-        &mut sinks.checker,
-        matches!(cfg.engine, EngineKind::EventList),
-    ) {
+    // every engine ends with a sweep of the state it ends in (a tunnelled ball has no event)
+    if let Some(c) = &mut sinks.checker {
         c.sweep_final(&table, &outcome.balls, outcome.t)?;
     }
     let wall = start.elapsed().as_secs_f64();

@@ -376,28 +376,10 @@ impl Scenario {
         let loops = self.closed_edges();
         for (i, b) in self.balls.iter().enumerate() {
             let p = b.position;
-            if inside_box(p, lo, hi) && loops.as_ref().is_some_and(|e| !encloses(e, p)) {
+            let field = format!("ball[{}].position", i + 1);
+            if !inside_box(p, lo, hi) {
                 return Err(invalid(
-                    format!("ball[{}].position", i + 1),
-                    format!(
-                        "Ball-{} at [{}, {}] is outside the table its cushions enclose",
-                        i + 1,
-                        p.x,
-                        p.y
-                    ),
-                ));
-            }
-            let inside_box = inside_box(p, lo, hi);
-            let through_cushion = self.cushions.iter().position(|c| {
-                let l = c.to - c.from;
-                let len = l.norm();
-                let along = (p - c.from).dot(l) / len;
-                let into = (p - c.from).dot(l.perp_cw()) / len;
-                along >= 0.0 && along <= len && into.abs() < b.radius * (1.0 - 1e-9)
-            });
-            if !inside_box {
-                return Err(invalid(
-                    format!("ball[{}].position", i + 1),
+                    field,
                     format!(
                         "Ball-{} at [{}, {}] is off the table (table spans [{}, {}] to [{}, {}])",
                         i + 1,
@@ -410,9 +392,27 @@ impl Scenario {
                     ),
                 ));
             }
+            if loops.as_ref().is_some_and(|e| !encloses(e, p)) {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "Ball-{} at [{}, {}] is outside the table its cushions enclose",
+                        i + 1,
+                        p.x,
+                        p.y
+                    ),
+                ));
+            }
+            let through_cushion = self.cushions.iter().position(|c| {
+                let l = c.to - c.from;
+                let len = l.norm();
+                let along = (p - c.from).dot(l) / len;
+                let into = (p - c.from).dot(l.perp_cw()) / len;
+                along >= 0.0 && along <= len && into.abs() < b.radius * (1.0 - 1e-9)
+            });
             if let Some(c) = through_cushion {
                 return Err(invalid(
-                    format!("ball[{}].position", i + 1),
+                    field,
                     format!("Ball-{} overlaps Cushion-{} at t = 0", i + 1, c + 1),
                 ));
             }
@@ -494,15 +494,17 @@ fn pts_empty(lo: Vec2) -> bool {
 /// accepted by built-ins that use them; a file takes none.
 pub fn load(spec: &str, params: &builtin::Params) -> Result<Scenario, ScenarioError> {
     let is_builtin = builtin::list().iter().any(|(name, _)| *name == spec);
+    // an error about the name itself, not about a field
+    let about_name = |message: String| ScenarioError {
+        source: spec.to_string(),
+        line: None,
+        field: String::new(),
+        message,
+    };
     if is_builtin && std::path::Path::new(spec).is_file() {
-        return Err(ScenarioError {
-            source: spec.to_string(),
-            line: None,
-            field: String::new(),
-            message: format!(
-                "names both a built-in scenario and a file here; write ./{spec} for the file"
-            ),
-        });
+        return Err(about_name(format!(
+            "names both a built-in scenario and a file here; write ./{spec} for the file"
+        )));
     }
     if is_builtin {
         return builtin::build(spec, params).map_err(|e| ScenarioError {
@@ -515,15 +517,10 @@ pub fn load(spec: &str, params: &builtin::Params) -> Result<Scenario, ScenarioEr
     let path = std::path::Path::new(spec);
     if !path.exists() {
         let names: Vec<&str> = builtin::list().iter().map(|(n, _)| *n).collect();
-        return Err(ScenarioError {
-            source: spec.to_string(),
-            line: None,
-            field: String::new(),
-            message: format!(
-                "no such file, and not a built-in scenario (built-ins: {})",
-                names.join(", ")
-            ),
-        });
+        return Err(about_name(format!(
+            "no such file, and not a built-in scenario (built-ins: {})",
+            names.join(", ")
+        )));
     }
     let given = [
         ("--balls", params.balls.is_some()),
