@@ -142,3 +142,33 @@ fn phold_on_ranks() {
         assert_eq!(got["time_warp"]["ranks"], ranks);
     }
 }
+
+/// `--check` on ranks: every committed event and the final state are checked, and only rank 0,
+/// which collects the final state, sweeps it (the other ranks hold their initial one).
+#[test]
+fn checked_run_on_ranks() {
+    let args = [
+        "run",
+        "gas",
+        "--balls",
+        "400",
+        "--sectors",
+        "auto",
+        "--check",
+        "--json",
+        "--quiet",
+    ];
+    let mut seq = args.to_vec();
+    seq.extend(["--engine", "objects"]);
+    let want = poolsim(None, None, &seq);
+    for ranks in [2, 3] {
+        let mut tw = args.to_vec();
+        tw.extend(["--engine", "time-warp", "--workers", "1"]);
+        let got = poolsim(Some(ranks), None, &tw);
+        assert_eq!(got["checked"], true, "{ranks} ranks");
+        assert_eq!(
+            got["final_state_digest"], want["final_state_digest"],
+            "{ranks} ranks"
+        );
+    }
+}
