@@ -44,8 +44,9 @@ mod floor;
 use entries::{Entries, Ref};
 pub use floor::Floor;
 
+use super::queue::Queue;
 use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime};
-use dary_heap::QuaternaryHeap;
+use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rustc_hash::FxHashMap;
@@ -441,7 +442,9 @@ pub struct Worker<M: Model> {
     placement: std::sync::Arc<Placement>,
     lps: Vec<Lp<M>>,
     entries: Entries<M::Msg>,
-    heap: QuaternaryHeap<Item>,
+    heap: Queue<Item>,
+    /// The key of the batch run last: messages for it go to the pending set's instant tier.
+    current: Key,
     /// Ops for this worker's objects, with the slot of their message's record when known.
     local_ops: Vec<(Op<M::Msg>, Option<u32>)>,
     outbox: Vec<Vec<Op<M::Msg>>>,
@@ -503,7 +506,8 @@ impl<M: Model> Worker<M> {
                 .collect(),
             placement,
             entries: Entries::default(),
-            heap: QuaternaryHeap::new(),
+            heap: Queue::default(),
+            current: Key::start(f64::NEG_INFINITY),
             local_ops: Vec::new(),
             outbox: (0..workers).map(|_| Vec::new()).collect(),
             chaos: chaos.map(|s| Chaos {
@@ -659,7 +663,8 @@ impl<M: Model> Worker<M> {
             if after {
                 let e = self.entries.at(r).expect("a live entry is held");
                 let p = e.p.as_ref().expect("a live entry holds its message");
-                self.heap.push(Item::of(r, p));
+                let in_instant = p.time.key == self.current;
+                self.heap.push(Item::of(r, p), in_instant);
             }
         }
         self.stats.peak_entries = self.stats.peak_entries.max(self.entries.len() as u64);
@@ -680,7 +685,7 @@ impl<M: Model> Worker<M> {
                     e.processed = false;
                     if e.live() {
                         let p = e.p.as_ref().expect("a live entry holds its message");
-                        self.heap.push(Item::of(r, p));
+                        self.heap.push(Item::of(r, p), false);
                     }
                 }
             }
@@ -715,7 +720,11 @@ impl<M: Model> Worker<M> {
     /// The smallest time of a live, unhandled message here (stale heap items dropped).
     fn next_time(&mut self) -> Option<f64> {
         while let Some(top) = self.heap.peek() {
-            if self.valid(top) {
+            let valid = self
+                .entries
+                .at(top.r)
+                .is_some_and(|e| e.live() && !e.processed);
+            if valid {
                 return Some(top.time.t());
             }
             self.heap.pop();
@@ -731,6 +740,9 @@ impl<M: Model> Worker<M> {
         }
         let first = self.heap.pop().expect("a valid top");
         let (time, to) = (first.time.clone(), first.to);
+        if self.current != time.key {
+            self.current = time.key.clone();
+        }
         let mut uids = vec![first.r];
         while let Some(top) = self.heap.peek() {
             if top.time != time || top.to != to {
