@@ -25,6 +25,11 @@ pub mod queue;
 pub mod sequential;
 pub mod time_warp;
 
+/// Pending messages an executor reserves room for per object (address space only until used,
+/// so that a pending set that grows to that size never copies itself into fresh pages): the
+/// sectored gas's set-up instant holds about 25 per object.
+pub const RESERVED_PER_OBJECT: usize = 32;
+
 use crate::vtime::Key;
 use serde::de::DeserializeOwned;
 use serde::Serialize;

@@ -87,6 +87,17 @@ impl<T: Ord> Default for Queue<T> {
 }
 
 impl<T: Ord> Queue<T> {
+    /// Room for `n` items in each tier without growing.
+    pub fn with_capacity(n: usize) -> Queue<T> {
+        Queue {
+            instant: Instant {
+                fresh: Vec::with_capacity(n),
+                ..Instant::default()
+            },
+            later: QuaternaryHeap::with_capacity(n),
+        }
+    }
+
     /// Adds an item, to the instant's tier if it belongs to the instant being run.
     pub fn push(&mut self, item: T, in_instant: bool) {
         if in_instant {

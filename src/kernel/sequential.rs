@@ -1,7 +1,7 @@
 //! The sequential executor: one pending set ([`Queue`]), batches run strictly in order.
 
 use super::queue::Queue;
-use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime};
+use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
 use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
 
@@ -51,11 +51,12 @@ impl<M: Model> Sequential<M> {
     /// Sets up the model's objects with their initial states and runs every object's `init` at
     /// virtual time `start` (in object order).
     pub fn new(model: M, states: Vec<M::State>, start: VTime) -> Sequential<M> {
+        let reserved = RESERVED_PER_OBJECT * states.len();
         let mut s = Sequential {
             seqs: vec![0; states.len()],
             model,
             states,
-            pending: Queue::default(),
+            pending: Queue::with_capacity(reserved),
             cancelled: FxHashSet::default(),
             stats: MessageStats::default(),
             now: None,

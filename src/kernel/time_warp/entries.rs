@@ -88,6 +88,15 @@ impl<Msg> Default for Entries<Msg> {
 }
 
 impl<Msg> Entries<Msg> {
+    /// Room for `n` records without growing (reserved, not touched: a growing slab copies
+    /// itself into fresh pages, which this VM zeroes slowly).
+    pub fn with_capacity(n: usize) -> Entries<Msg> {
+        Entries {
+            slab: Vec::with_capacity(n),
+            ..Entries::default()
+        }
+    }
+
     /// Messages held.
     pub fn len(&self) -> usize {
         self.slab.len() - self.free.len()

@@ -45,7 +45,7 @@ use entries::{Entries, Ref};
 pub use floor::Floor;
 
 use super::queue::Queue;
-use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime};
+use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
 use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -489,6 +489,7 @@ impl<M: Model> Worker<M> {
         chaos: Option<u64>,
     ) -> Worker<M> {
         let workers = placement.workers();
+        let n_objects = states.len();
         Worker {
             index,
             lps: states
@@ -505,8 +506,8 @@ impl<M: Model> Worker<M> {
                 })
                 .collect(),
             placement,
-            entries: Entries::default(),
-            heap: Queue::default(),
+            entries: Entries::with_capacity(RESERVED_PER_OBJECT * n_objects),
+            heap: Queue::with_capacity(RESERVED_PER_OBJECT * n_objects),
             current: Key::start(f64::NEG_INFINITY),
             local_ops: Vec::new(),
             outbox: (0..workers).map(|_| Vec::new()).collect(),
