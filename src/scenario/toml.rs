@@ -411,6 +411,9 @@ fn located(text: &str, source: &str, span: Option<Range<usize>>, inv: Invalid) -
 /// Turns toml's error (which names no key once it has the source text) into one line: the line
 /// comes from its span; the field is found by scanning the text for the table and key there.
 fn toml_error(text: &str, source: &str, e: &::toml::de::Error) -> ScenarioError {
+    if let Some(wrong) = wrong_header(text, source) {
+        return wrong;
+    }
     let span = e.span();
     let syntax = ::toml::from_str::<IgnoredAny>(text).is_err();
     let field = match (&span, syntax) {
@@ -423,6 +426,33 @@ fn toml_error(text: &str, source: &str, e: &::toml::de::Error) -> ScenarioError 
         field,
         message: clarify(&one_line(e.message())),
     }
+}
+
+/// A table header of the wrong kind: `[[run]]` or `[[sectors]]` (one table each), or `[ball]`,
+/// `[cushion]`, `[pocket]` or `[sectors.polygon]` (one table per item). Serde would report
+/// these as a type mismatch inside the table.
+fn wrong_header(text: &str, source: &str) -> Option<ScenarioError> {
+    const LISTS: [&str; 4] = ["ball", "cushion", "pocket", "sectors.polygon"];
+    scan(text, text.len()).into_iter().find_map(|item| {
+        let Item::Header { start, name, array } = item else {
+            return None;
+        };
+        let message = match (array, LISTS.contains(&name.as_str())) {
+            (true, false) if name == "run" || name == "sectors" => {
+                format!("`[[{name}]]` makes a list of tables; the file has one: write `[{name}]`")
+            }
+            (false, true) => {
+                format!("`[{name}]` is a single table; write `[[{name}]]` once per item")
+            }
+            _ => return None,
+        };
+        Some(ScenarioError {
+            source: source.to_string(),
+            line: Some(line_of(text, start)),
+            field: name,
+            message,
+        })
+    })
 }
 
 /// Rewrites the one confusing message toml gives: a table written where a single value belongs
@@ -823,6 +853,19 @@ grid = [2, 3]
     fn zero_length_cushion() {
         let e = fails(&with_line(19, "to = [0.0, 400.0]"));
         assert_error(&e, 17, "cushion[2]", "zero length");
+    }
+
+    #[test]
+    fn a_header_of_the_wrong_kind_says_which_to_write() {
+        let e = fails(&with_line(1, "[[run]]"));
+        assert_error(&e, 1, "run", "write `[run]`");
+        let e = fails(&with_line(4, "[ball]"));
+        assert_error(&e, 4, "ball", "write `[[ball]]` once per item");
+        let e = fails(&with_line(36, "[[sectors]]"));
+        assert_error(&e, 36, "sectors", "write `[sectors]`");
+        let polygon = "[[run]]\nuntil = 1\n[sectors.polygon]\npoints = [[0, 0], [0, 1], [1, 1]]\n";
+        let e = fails(&polygon.replace("[[run]]", "[run]"));
+        assert_error(&e, 3, "sectors.polygon", "write `[[sectors.polygon]]`");
     }
 
     #[test]
