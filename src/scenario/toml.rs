@@ -416,15 +416,21 @@ fn toml_error(text: &str, source: &str, e: &::toml::de::Error) -> ScenarioError 
     }
     let span = e.span();
     let syntax = ::toml::from_str::<IgnoredAny>(text).is_err();
-    let field = match (&span, syntax) {
-        (Some(s), false) => field_at(text, s.start),
-        _ => String::new(),
+    let line = span.as_ref().map(|s| line_of(text, s.start));
+    let (field, message) = match (&span, syntax) {
+        // the line toml names may be past the statement at fault: name no field
+        (_, true) => (
+            String::new(),
+            format!("not valid TOML: {}", one_line(e.message())),
+        ),
+        (Some(s), false) => (field_at(text, s.start), clarify(&one_line(e.message()))),
+        (None, false) => (String::new(), clarify(&one_line(e.message()))),
     };
     ScenarioError {
         source: source.to_string(),
-        line: span.map(|s| line_of(text, s.start)),
+        line,
         field,
-        message: clarify(&one_line(e.message())),
+        message,
     }
 }
 
@@ -869,6 +875,15 @@ grid = [2, 3]
     }
 
     #[test]
+    fn a_syntax_error_says_so() {
+        let e = fails(&with_line(2, "until = 1.0.0"));
+        assert_eq!(
+            e.to_string(),
+            "t.toml:2: not valid TOML: expected newline, `#`"
+        );
+    }
+
+    #[test]
     fn unknown_key() {
         let e = fails(&with_line(8, "colour = 3"));
         assert_error(&e, 8, "ball[1].colour", "unknown field `colour`");
@@ -906,7 +921,10 @@ grid = [2, 3]
         let e = fails(&with_line(15, "from = [0.0, 0.0"));
         assert_eq!(e.field, "");
         assert_eq!(e.line, Some(16), "{e}");
-        assert_eq!(e.to_string(), "t.toml:16: invalid array; expected `]`");
+        assert_eq!(
+            e.to_string(),
+            "t.toml:16: not valid TOML: invalid array; expected `]`"
+        );
         let e = fails(&with_line(7, "radius = = 20"));
         assert_eq!((e.line, e.field.as_str()), (Some(7), ""), "{e}");
         assert!(!e.to_string().contains('\n'));
