@@ -469,6 +469,10 @@ impl Progress {
             ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}")
                 .expect("a valid template"),
         );
+        // the spinner and clock move even before the first event: setting up a large sectored
+        // table takes a while
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        bar.set_message(format!("t = 0 / {until}, 0 events"));
         Some(Progress {
             bar,
             until,
