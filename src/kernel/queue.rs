@@ -5,14 +5,20 @@
 
 use dary_heap::QuaternaryHeap;
 
-/// The instant's items: a sorted run taken from its end, and the items pushed since it was
-/// sorted. Within an instant a batch sends only to later generations, so a push almost never
-/// comes before the run's next item; the fresh items are sorted once, when the run is spent
-/// (or, if one of them must come first, with it). An instant of millions of messages, as
-/// the sectored gas's set-up, then costs one sort instead of a heap operation each.
+/// Run items sorted again with fresh ones however few these are (beyond it, only four per fresh
+/// item).
+const SORT_TOGETHER: usize = 64;
+
+/// The instant's items: a sorted run taken from its end, a small heap, and the items pushed
+/// since the run was sorted. Within an instant a batch sends only to later generations, so the
+/// pushed items are not needed until the run is spent; they are then sorted once. An instant of
+/// millions of messages, as the sectored gas's set-up, costs one sort instead of a heap
+/// operation each. Items pushed that must come before some of the run go to the heap instead,
+/// so that no order of pushes costs more than a heap would.
 struct Instant<T: Ord> {
-    /// Greatest last: the next item is `run.last()`.
+    /// Greatest last.
     run: Vec<T>,
+    side: QuaternaryHeap<T>,
     fresh: Vec<T>,
     /// The index of the greatest fresh item.
     best: Option<usize>,
@@ -22,6 +28,7 @@ impl<T: Ord> Default for Instant<T> {
     fn default() -> Self {
         Instant {
             run: Vec::new(),
+            side: QuaternaryHeap::new(),
             fresh: Vec::new(),
             best: None,
         }
@@ -36,36 +43,68 @@ impl<T: Ord> Instant<T> {
         self.fresh.push(item);
     }
 
-    /// Makes `run.last()` the greatest item held.
+    /// The greater of the run's and the heap's next items.
+    fn settled_top(&self) -> Option<&T> {
+        match (self.run.last(), self.side.peek()) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// The greatest item held.
+    fn top(&self) -> Option<&T> {
+        let fresh = self.best.map(|b| &self.fresh[b]);
+        match (self.settled_top(), fresh) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// Makes the greatest item the run's or the heap's next: the fresh items are sorted into
+    /// the run when it is short or spent, or go to the heap when one of them comes before a long
+    /// run's rest.
     fn settle(&mut self) {
         let Some(b) = self.best else { return };
-        if self.run.last().is_some_and(|last| *last >= self.fresh[b]) {
+        if self.settled_top().is_some_and(|top| *top >= self.fresh[b]) {
             return;
         }
-        // the run's items are few (an instant's last generation) or already in order: one
-        // unstable sort of both, which allocates nothing
-        self.fresh.append(&mut self.run);
-        self.fresh.sort_unstable();
-        std::mem::swap(&mut self.run, &mut self.fresh);
+        if self.run.len() <= SORT_TOGETHER + 4 * self.fresh.len() {
+            // a short run (the common case: an instant's last few messages) is sorted again
+            // with the fresh items, at a cost bounded by theirs
+            self.fresh.append(&mut self.run);
+            self.fresh.sort_unstable();
+            std::mem::swap(&mut self.run, &mut self.fresh);
+        } else {
+            self.side.extend(self.fresh.drain(..));
+        }
         self.best = None;
     }
 
     fn peek(&mut self) -> Option<&T> {
         self.settle();
-        self.run.last()
+        self.settled_top()
     }
 
     fn pop(&mut self) -> Option<T> {
         self.settle();
-        self.run.pop()
+        let from_run = match (self.run.last(), self.side.peek()) {
+            (Some(a), Some(b)) => a >= b,
+            (a, _) => a.is_some(),
+        };
+        if from_run {
+            self.run.pop()
+        } else {
+            self.side.pop()
+        }
     }
 
     fn len(&self) -> usize {
-        self.run.len() + self.fresh.len()
+        self.run.len() + self.side.len() + self.fresh.len()
     }
 
     fn retain(&mut self, mut keep: impl FnMut(&T) -> bool) {
         self.run.retain(&mut keep);
+        self.side.retain(&mut keep);
         self.fresh.retain(&mut keep);
         self.best = (0..self.fresh.len()).max_by(|&i, &j| self.fresh[i].cmp(&self.fresh[j]));
     }
@@ -108,8 +147,8 @@ impl<T: Ord> Queue<T> {
     }
 
     /// Whether the next item is the large heap's.
-    fn later_first(&mut self) -> bool {
-        match (self.instant.peek(), self.later.peek()) {
+    fn later_first(&self) -> bool {
+        match (self.instant.top(), self.later.peek()) {
             (Some(a), Some(b)) => b > a,
             (Some(_), None) => false,
             (None, _) => true,
@@ -208,5 +247,58 @@ mod tests {
             let got: Vec<u32> = std::iter::from_fn(|| q.pop()).collect();
             prop_assert_eq!(got, left);
         }
+    }
+
+    thread_local! {
+        static COMPARISONS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    }
+
+    /// A number that counts its comparisons.
+    #[derive(PartialEq, Eq)]
+    struct Counted(u32);
+
+    impl PartialOrd for Counted {
+        fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+            Some(self.cmp(o))
+        }
+    }
+
+    impl Ord for Counted {
+        fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+            COMPARISONS.with(|c| c.set(c.get() + 1));
+            self.0.cmp(&o.0)
+        }
+    }
+
+    /// One instant of n items where every batch pushes items that come before the rest of the
+    /// run (the receivers of each batch's sends interleave with the earlier ones): the cost stays
+    /// O(n log n) comparisons, as a heap's would, never a sort of the whole run per batch.
+    #[test]
+    fn pushes_before_the_run_cost_no_more_than_a_heap() {
+        let n = 1u32 << 14;
+        let mut q = Queue::default();
+        COMPARISONS.with(|c| c.set(0));
+        // a first batch fills the run; each later pop is followed by pushes that precede the
+        // rest of the run (greater, as the executors reverse the delivery order)
+        for k in 0..64 {
+            q.push(Counted(k), true);
+        }
+        let mut next = 64;
+        let mut popped = 0;
+        while let Some(Counted(_)) = q.pop() {
+            popped += 1;
+            if next < n {
+                for _ in 0..4 {
+                    q.push(Counted(n + next), true);
+                    next += 1;
+                }
+            }
+        }
+        assert_eq!(popped, n);
+        let per_item = COMPARISONS.with(|c| c.get()) as f64 / f64::from(n);
+        assert!(
+            per_item < 4.0 * f64::from(n).log2(),
+            "{per_item} comparisons per item"
+        );
     }
 }
