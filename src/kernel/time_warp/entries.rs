@@ -88,8 +88,8 @@ impl<Msg> Default for Entries<Msg> {
 }
 
 impl<Msg> Entries<Msg> {
-    /// Room for `n` records without growing (reserved, not touched: a growing slab copies
-    /// itself into fresh pages, which this VM zeroes slowly).
+    /// Room for `n` records without growing (address space, not touched until used: a growing
+    /// slab copies itself into fresh pages, each a fault and a zeroing).
     pub fn with_capacity(n: usize) -> Entries<Msg> {
         Entries {
             slab: Vec::with_capacity(n),
