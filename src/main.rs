@@ -795,7 +795,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
     #[cfg(feature = "mpi")]
     let _mpi = if time_warp { start_mpi()? } else { None };
     // under MPI only rank 0 writes anything
-    let root = poolsim::kernel::time_warp::threads::place().0 == 0;
+    let root = poolsim::kernel::time_warp::threads::collects_results();
     let mut trace = match a.trace.as_ref().filter(|_| root) {
         Some(p) => Some(TraceWriter::new(BufWriter::new(File::create(p).map_err(
             |e| {

@@ -252,9 +252,9 @@ pub fn execute(
         }
     };
     // every engine ends with a sweep of the state it ends in (a tunnelled ball has no event);
-    // under MPI only rank 0 collects the final state, the other ranks hold their initial one
-    let collects_final_state = crate::kernel::time_warp::threads::place().0 == 0;
-    if let Some(c) = sinks.checker.as_mut().filter(|_| collects_final_state) {
+    // under MPI only rank 0 collects the final state
+    let collects = crate::kernel::time_warp::threads::collects_results();
+    if let Some(c) = sinks.checker.as_mut().filter(|_| collects) {
         c.sweep_final(&table, &outcome.balls, outcome.t)?;
     }
     let wall = start.elapsed().as_secs_f64();

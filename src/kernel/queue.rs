@@ -43,21 +43,14 @@ impl<T: Ord> Instant<T> {
         self.fresh.push(item);
     }
 
-    /// The greater of the run's and the heap's next items.
+    /// The greater of the run's and the heap's next items (`None` is below every item).
     fn settled_top(&self) -> Option<&T> {
-        match (self.run.last(), self.side.peek()) {
-            (Some(a), Some(b)) => Some(a.max(b)),
-            (a, b) => a.or(b),
-        }
+        self.run.last().max(self.side.peek())
     }
 
     /// The greatest item held.
     fn top(&self) -> Option<&T> {
-        let fresh = self.best.map(|b| &self.fresh[b]);
-        match (self.settled_top(), fresh) {
-            (Some(a), Some(b)) => Some(a.max(b)),
-            (a, b) => a.or(b),
-        }
+        self.settled_top().max(self.best.map(|b| &self.fresh[b]))
     }
 
     /// Makes the greatest item the run's or the heap's next: the fresh items are sorted into
@@ -87,11 +80,7 @@ impl<T: Ord> Instant<T> {
 
     fn pop(&mut self) -> Option<T> {
         self.settle();
-        let from_run = match (self.run.last(), self.side.peek()) {
-            (Some(a), Some(b)) => a >= b,
-            (a, _) => a.is_some(),
-        };
-        if from_run {
+        if self.run.last() >= self.side.peek() {
             self.run.pop()
         } else {
             self.side.pop()
@@ -148,11 +137,7 @@ impl<T: Ord> Queue<T> {
 
     /// Whether the next item is the large heap's.
     fn later_first(&self) -> bool {
-        match (self.instant.top(), self.later.peek()) {
-            (Some(a), Some(b)) => b > a,
-            (Some(_), None) => false,
-            (None, _) => true,
-        }
+        self.later.peek() > self.instant.top()
     }
 
     /// The next item.

@@ -260,6 +260,12 @@ pub fn place() -> (usize, usize) {
     }
 }
 
+/// Whether this process collects the run's results: always on threads, rank 0 under MPI (the
+/// other ranks write nothing and hold their objects' initial states at the end).
+pub fn collects_results() -> bool {
+    place().0 == 0
+}
+
 /// Workers in all (every rank's) for `cfg`.
 pub fn total_workers(cfg: &TwConfig) -> usize {
     cfg.workers.max(1) * place().1
