@@ -116,6 +116,10 @@ struct RunArgs {
     /// Batches a Time Warp worker runs between GVT rounds.
     #[arg(long = "gvt-interval")]
     gvt_interval: Option<u32>,
+    /// Pure Time Warp: every batch runs optimistically, with its state saved, even one that
+    /// nothing can roll back any more (by default such a batch runs as final, on threads).
+    #[arg(long = "tw-pure")]
+    tw_pure: bool,
     /// Delay of NewVelocity messages (objects engines).
     #[arg(long = "newvelocity-delay")]
     newvelocity_delay: Option<String>,
@@ -247,6 +251,7 @@ fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
         tw_window: None,
         tw_memory: None,
         gvt_interval: None,
+        tw_pure: false,
         newvelocity_delay: a.newvelocity_delay.clone(),
         dt: a.dt,
         quiet: true,
@@ -706,6 +711,7 @@ fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
         }
         tw.gvt_interval = g;
     }
+    tw.final_batches = !a.tw_pure;
     Ok(tw)
 }
 
@@ -774,6 +780,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         ("--tw-window", a.tw_window.is_some()),
         ("--tw-memory", a.tw_memory.is_some()),
         ("--gvt-interval", a.gvt_interval.is_some()),
+        ("--tw-pure", a.tw_pure),
     ] {
         if given && !time_warp {
             return Err(usage(format!("{flag}: only the time-warp engine takes it")));
@@ -979,6 +986,7 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
         tw_window: None,
         tw_memory: None,
         gvt_interval: None,
+        tw_pure: false,
         newvelocity_delay: a.newvelocity_delay.clone(),
         dt: None,
         quiet: true,

@@ -38,11 +38,22 @@ fn sequential(sectors: Option<SectorChoice>) -> EngineKind {
 }
 
 fn time_warp(sectors: Option<SectorChoice>, workers: usize, chaos: Option<u64>) -> EngineKind {
+    pure_or_not(sectors, workers, chaos, false)
+}
+
+/// Time Warp, `pure` or with batches that nothing can roll back run as final.
+fn pure_or_not(
+    sectors: Option<SectorChoice>,
+    workers: usize,
+    chaos: Option<u64>,
+    pure: bool,
+) -> EngineKind {
     EngineKind::TimeWarp {
         tw: TwConfig {
             workers,
             chaos,
             gvt_interval: 256,
+            final_batches: !pure,
             ..TwConfig::default()
         },
         delay: NvDelay::Exact,
@@ -50,14 +61,18 @@ fn time_warp(sectors: Option<SectorChoice>, workers: usize, chaos: Option<u64>) 
     }
 }
 
-/// Runs `s` sequentially and under Time Warp on 1, 2 and 3 workers, with and without chaos.
+/// Runs `s` sequentially and under Time Warp on 1, 2 and 3 workers, with and without chaos,
+/// pure and not.
 fn assert_same(s: &Scenario, sectors: Option<SectorChoice>) -> Vec<serde_json::Value> {
     let want = run(s, sequential(sectors));
     let mut stats = Vec::new();
-    for workers in [1, 2, 3] {
+    for (workers, pure) in [1, 2, 3].into_iter().flat_map(|w| [(w, false), (w, true)]) {
         for chaos in [None, Some(workers as u64 * 31 + 5)] {
-            let got = run(s, time_warp(sectors, workers, chaos));
-            let what = format!("{} {sectors:?} workers {workers} chaos {chaos:?}", s.name);
+            let got = run(s, pure_or_not(sectors, workers, chaos, pure));
+            let what = format!(
+                "{} {sectors:?} workers {workers} chaos {chaos:?} pure {pure}",
+                s.name
+            );
             assert_eq!(got.trace, want.trace, "{what}: traces differ");
             for field in ["final_state_digest", "messages", "events"] {
                 assert_eq!(got.summary[field], want.summary[field], "{what}: {field}");
@@ -69,6 +84,13 @@ fn assert_same(s: &Scenario, sectors: Option<SectorChoice>) -> Vec<serde_json::V
                 want.summary["engine_stats"]["batches"].as_f64(),
                 "{what}: every sequential batch committed once"
             );
+            let finals = tw["final_batches"].as_u64().unwrap();
+            if pure {
+                assert_eq!(finals, 0, "{what}: pure Time Warp runs nothing as final");
+            } else if workers == 1 {
+                // nothing else sends: every batch is before everything still to come
+                assert_eq!(Some(finals), tw["committed"].as_u64(), "{what}");
+            }
             stats.push(tw.clone());
         }
     }
@@ -139,6 +161,8 @@ fn a_tight_memory_budget_rolls_back_and_stays_exact() {
             chaos: Some(3),
             gvt_interval: 4096,
             max_uncommitted: 64,
+            // every batch saved, so that the budget binds
+            final_batches: false,
             window: Some(0.05),
         },
         delay: NvDelay::Exact,
@@ -296,4 +320,23 @@ fn the_projectors_frames_are_the_sequential_ones() {
             "{workers} workers"
         );
     }
+}
+
+#[test]
+fn batches_run_as_final_beside_optimistic_ones() {
+    // big enough that two workers pass each other many times
+    let mut s = gas(900, 4);
+    s.until = 2.0;
+    let sectors = Some(SectorChoice::Auto);
+    let want = run(&s, sequential(sectors));
+    let got = run(&s, time_warp(sectors, 2, None));
+    assert_eq!(got.trace, want.trace);
+    let tw = &got.summary["time_warp"];
+    let (finals, committed) = (tw["final_batches"].as_u64(), tw["committed"].as_u64());
+    let (finals, committed) = (finals.unwrap(), committed.unwrap());
+    assert!(finals > 0, "no batch ran as final: {tw}");
+    assert!(
+        finals < committed,
+        "every batch ran as final on 2 workers: {tw}"
+    );
 }

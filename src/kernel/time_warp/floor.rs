@@ -67,6 +67,12 @@ impl Floor {
             .is_gt()
     }
 
+    /// Whether the batch of object `to` at `time` comes at or before this floor.
+    pub fn reaches(&self, time: &VTime, to: u32) -> bool {
+        self.cmp_with(time.key.t, &time.key.path, time.gen, to)
+            .is_ge()
+    }
+
     /// How this floor compares with the place (time `t`, key path, generation, receiver).
     fn cmp_with(&self, t: f64, path: &[u64], gen: u32, to: u32) -> Ordering {
         self.t

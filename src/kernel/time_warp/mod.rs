@@ -74,6 +74,9 @@ pub struct TwConfig {
     /// Uncommitted batches a worker may hold before it rolls its furthest objects back and
     /// runs only batches at GVT; past four times this, the run stops with an error.
     pub max_uncommitted: usize,
+    /// Whether a batch before every op the other workers may still send runs as final: without
+    /// saving its object's state, committed at once (threads only; see [`Fabric::peers_floor`]).
+    pub final_batches: bool,
 }
 
 impl Default for TwConfig {
@@ -84,6 +87,7 @@ impl Default for TwConfig {
             gvt_interval: 2048,
             window: None,
             max_uncommitted: 1 << 21,
+            final_batches: true,
         }
     }
 }
@@ -99,6 +103,9 @@ pub struct TwStats {
     pub processed: u64,
     /// Batches committed.
     pub committed: u64,
+    /// Of them, batches run as final: before every op another worker could still send, so
+    /// without saving state (counted in `processed` too).
+    pub final_batches: u64,
     /// Batches undone by rollbacks.
     pub rolled_back: u64,
     /// Rollbacks (one object rolled back once).
@@ -140,6 +147,7 @@ impl TwStats {
         self.workers += o.workers;
         self.processed += o.processed;
         self.committed += o.committed;
+        self.final_batches += o.final_batches;
         self.rolled_back += o.rolled_back;
         self.rollbacks += o.rollbacks;
         self.artificial_rollbacks += o.artificial_rollbacks;
@@ -269,6 +277,19 @@ pub trait Fabric<M: Model>: Sync {
     fn reduce(&self, me: usize, local: Reduction) -> Reduction;
     /// Hands a chunk of committed batches to the collector.
     fn commit(&self, chunk: Chunk<M::State, M::Output>);
+    /// Whether workers publish floors here and [`Fabric::peers_floor`] can answer: without,
+    /// no batch runs as final.
+    fn shares_floors(&self) -> bool {
+        false
+    }
+    /// Publishes a floor below everything worker `me` holds or has yet to send (taking ops
+    /// from its inbox lowers it to theirs).
+    fn publish(&self, _me: usize, _floor: Floor) {}
+    /// A floor below every op another worker may still send worker `me`, when the fabric can
+    /// tell: the published floors and the ops waiting in inboxes, read at one instant.
+    fn peers_floor(&self, _me: usize) -> Option<Floor> {
+        None
+    }
 }
 
 /// A heap entry: a live message's delivery order and where its record is.
@@ -340,7 +361,8 @@ struct Sent {
 /// A batch an object ran that is not committed yet.
 struct Done<M: Model> {
     time: VTime,
-    pre_state: M::State,
+    /// The object's state before it; `None` for a batch run as final.
+    pre_state: Option<M::State>,
     pre_seq: u64,
     inputs: Vec<Ref>,
     sent: Vec<(Sent, u16)>,
@@ -384,6 +406,15 @@ impl<M: Model> Lp<M> {
         sent.binary_search_by_key(&seq, |(s, _)| s.seq)
             .ok()
             .map(|i| &sent[i].0)
+    }
+
+    /// Forgets filed sends that GVT passed (delivered: cancelling them does nothing), once
+    /// there are many (amortized: the threshold doubles with what is left).
+    fn sweep_sends(&mut self, gvt: &Floor) {
+        if self.sends.len() > self.sweep_at {
+            self.sends.retain(|_, s| !gvt.passed(&s.time, s.to));
+            self.sweep_at = 2 * self.sends.len().max(32);
+        }
     }
 
     fn next_uid(&mut self) -> u64 {
@@ -469,6 +500,23 @@ pub struct Worker<M: Model> {
     graveyard: Vec<(f64, Ref)>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
+    /// Whether batches may run as final ([`TwConfig::final_batches`]).
+    final_ok: bool,
+    /// Whether the collector wants observed objects' states.
+    ship: bool,
+    /// Below every op another worker may still send here, as last found (lowered by every op
+    /// this worker sends away since).
+    final_bound: Floor,
+    /// Batches to wait before asking the fabric for a new bound after a failed try.
+    bound_wait: u32,
+    /// The last batch run as final: no op may come at or before it.
+    final_floor: Floor,
+    /// Below every op in the outboxes.
+    outbox_floor: Floor,
+    /// Batches committed between GVT rounds (run as final), for the chunk of the first round
+    /// whose GVT passes them: the collector puts out a round's batches after the round
+    /// before's, and a final batch may be later than a batch another worker has yet to commit.
+    early: Vec<Committed<M::State, M::Output>>,
 }
 
 /// Why a worker stopped early.
@@ -532,6 +580,13 @@ impl<M: Model> Worker<M> {
             fault: None,
             graveyard: Vec::new(),
             active: Vec::new(),
+            final_ok: false,
+            ship: false,
+            final_bound: Floor::NEG_INFINITY,
+            bound_wait: 0,
+            final_floor: Floor::NEG_INFINITY,
+            outbox_floor: Floor::INFINITY,
+            early: Vec::new(),
         }
     }
 
@@ -618,6 +673,9 @@ impl<M: Model> Worker<M> {
         if w == self.index {
             self.local_ops.push((op, slot));
         } else {
+            let f = Floor::of(op.time(), op.to());
+            self.outbox_floor = self.outbox_floor.min(f);
+            self.final_bound = self.final_bound.min(f);
             self.outbox[w].push(op);
         }
     }
@@ -636,6 +694,12 @@ impl<M: Model> Worker<M> {
             Op::Msg { uid, p } => (*uid, p.time.clone()),
             Op::Anti { uid, time, .. } | Op::Cancel { uid, time, .. } => (*uid, time.clone()),
         };
+        if self.final_floor.reaches(&time, to) {
+            self.fault.get_or_insert(format!(
+                "time warp: an op for object {to} at t = {} came after a later batch ran as final",
+                time.t()
+            ));
+        }
         let r = self.entries.open(uid, slot);
         let e = self.entries.at_mut(r).expect("an open record");
         let before = e.live();
@@ -679,7 +743,7 @@ impl<M: Model> Worker<M> {
             let d = lp.history.pop_back().expect("a batch to undo");
             self.uncommitted -= 1;
             self.stats.rolled_back += 1;
-            lp.state = d.pre_state;
+            lp.state = d.pre_state.expect("an uncommitted batch saved its state");
             lp.seq = d.pre_seq;
             for r in d.inputs {
                 if let Some(e) = self.entries.at_mut(r) {
@@ -733,8 +797,37 @@ impl<M: Model> Worker<M> {
         None
     }
 
+    /// Whether the batch of `to` at `time` may run as final: no op another worker may still
+    /// send, none this worker holds back (chaos) and none waiting in its outboxes comes at or
+    /// before it. Asks the fabric again only when the last bound does not answer and a few
+    /// batches have passed since the last try.
+    fn may_run_final<F: Fabric<M>>(&mut self, fabric: &F, time: &VTime, to: u32) -> bool {
+        if self.final_bound.passed(time, to) {
+            return true;
+        }
+        if self.bound_wait > 0 {
+            self.bound_wait -= 1;
+            return false;
+        }
+        if let Some(peers) = fabric.peers_floor(self.index) {
+            let mut b = peers.min(self.outbox_floor);
+            if let Some(c) = &self.chaos {
+                for (_, op) in &c.held {
+                    b = b.min(Floor::of(op.time(), op.to()));
+                }
+            }
+            self.final_bound = b;
+        }
+        let ok = self.final_bound.passed(time, to);
+        if !ok {
+            // each try locks every worker's slot twice
+            self.bound_wait = self.placement.workers() as u32 - 1;
+        }
+        ok
+    }
+
     /// Runs the next batch if its time is at most `limit`; false when there is none.
-    fn step(&mut self, model: &M, limit: f64) -> bool {
+    fn step<F: Fabric<M>>(&mut self, model: &M, fabric: &F, limit: f64) -> bool {
         match self.next_time() {
             Some(t) if t <= limit => {}
             _ => return false,
@@ -763,11 +856,21 @@ impl<M: Model> Worker<M> {
             })
             .collect();
         let li = self.placement.local(to);
-        let lp = &mut self.lps[li];
         debug_assert!(
-            lp.last_time().is_none_or(|t| *t < time),
+            self.lps[li].last_time().is_none_or(|t| *t < time),
             "batches run in order"
         );
+        // a batch before everything still to come is final, and so are the object's earlier
+        // ones: commit those, and run this one without saving the state
+        let mut run_final = self.final_ok && self.may_run_final(fabric, &time, to);
+        if run_final {
+            let mut out = std::mem::take(&mut self.early);
+            self.commit_front(model, li, &Floor::of(&time, to), &mut out);
+            self.early = out;
+            // a key deeper than a floor keeps may leave batches of the instant uncommitted
+            run_final = self.lps[li].history.is_empty();
+        }
+        let lp = &mut self.lps[li];
         if time.key.depth() > MAX_CASCADE_DEPTH {
             // GVT cannot pass an instant this deep, so it would pile up batches until memory ran out
             self.fault.get_or_insert(format!(
@@ -776,7 +879,7 @@ impl<M: Model> Worker<M> {
                 time.t()
             ));
         }
-        let pre_state = lp.state.clone();
+        let pre_state = (!run_final).then(|| lp.state.clone());
         let pre_seq = lp.seq;
         let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq);
         model.handle(&mut ctx, to, &mut lp.state, &batch);
@@ -823,11 +926,7 @@ impl<M: Model> Worker<M> {
             };
             ops.push((op, c.slot));
         }
-        if !lp.active {
-            lp.active = true;
-            self.active.push(li as u32);
-        }
-        lp.history.push_back(Done {
+        let done = Done {
             time,
             pre_state,
             pre_seq,
@@ -837,10 +936,26 @@ impl<M: Model> Worker<M> {
             cancel_calls: cancelled.len() as u32,
             output,
             into_past,
-        });
-        self.uncommitted += 1;
+        };
         self.stats.processed += 1;
-        self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
+        if run_final {
+            self.stats.final_batches += 1;
+            self.final_floor = Floor::of(&done.time, to);
+            let state = (self.ship && model.observed(to)).then(|| lp.state.clone());
+            let (gvt, floor) = (self.gvt, self.final_floor);
+            let mut out = std::mem::take(&mut self.early);
+            self.commit(li, done, state, &floor, &mut out);
+            self.early = out;
+            self.lps[li].sweep_sends(&gvt);
+        } else {
+            if !lp.active {
+                lp.active = true;
+                self.active.push(li as u32);
+            }
+            lp.history.push_back(done);
+            self.uncommitted += 1;
+            self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
+        }
         for (op, slot) in ops {
             self.route(op, slot);
         }
@@ -902,10 +1017,17 @@ impl<M: Model> Worker<M> {
         self.drain_local();
     }
 
+    /// Sends the outboxes' ops, then publishes this worker's floor (the ops' inboxes cover
+    /// them from there).
     fn flush<F: Fabric<M>>(&mut self, fabric: &F) {
         for (w, ops) in self.take_outbox(0..self.outbox.len()) {
             self.sent_ops += ops.len() as i64;
             fabric.send(self.index, w, ops);
+        }
+        self.outbox_floor = Floor::INFINITY;
+        if self.final_ok {
+            let floor = self.local_min();
+            fabric.publish(self.index, floor);
         }
     }
 
@@ -953,71 +1075,101 @@ impl<M: Model> Worker<M> {
         }
     }
 
-    /// Commits every batch before `gvt`: frees its saved state and messages, and returns those
-    /// the collector needs (output, and observed states when `ship`), in no particular order.
-    fn fossil_collect(
+    /// Commits one batch of local object `li`: counts it, files the sends a later batch may
+    /// still cancel (those `floor` has not passed), frees its input records, and keeps for the
+    /// collector what its sinks see (`state` is the object's state after it, when observed).
+    fn commit(
+        &mut self,
+        li: usize,
+        d: Done<M>,
+        state: Option<M::State>,
+        floor: &Floor,
+        out: &mut Vec<Committed<M::State, M::Output>>,
+    ) {
+        if let Some(what) = d.into_past {
+            self.fault
+                .get_or_insert(format!("model bug in a committed batch: {what}"));
+        }
+        self.stats.committed += 1;
+        let lp = &mut self.lps[li];
+        let cs = &mut self.committed_stats;
+        cs.batches += 1;
+        cs.delivered += d.inputs.len() as u64;
+        cs.cancels += u64::from(d.cancel_calls);
+        for (s, kind) in d.sent {
+            cs.count(usize::from(kind));
+            // still ahead: it may yet be cancelled by a later batch
+            if s.retractable && !floor.passed(&s.time, s.to) {
+                lp.sends.insert(s.seq, s);
+            }
+        }
+        for &r in &d.inputs {
+            self.entries.remove(r);
+        }
+        // a committed cancellation is final: its message needs no name any more
+        for c in &d.cancels {
+            lp.sends.remove(&c.seq);
+        }
+        // the collector needs only what its sinks see
+        if state.is_some() || !d.output.is_empty() {
+            out.push(Committed {
+                time: d.time,
+                obj: lp.id,
+                state,
+                output: d.output,
+            });
+        }
+    }
+
+    /// Commits the batches of local object `li` that `floor` passed, oldest first.
+    fn commit_front(
         &mut self,
         model: &M,
-        gvt: Floor,
-        ship: bool,
-    ) -> Vec<Committed<M::State, M::Output>> {
-        let mut out = Vec::new();
-        let mut still = Vec::with_capacity(self.active.len());
-        for &li in &self.active {
-            let lp = &mut self.lps[li as usize];
-            let observed = ship && model.observed(lp.id);
-            while lp
+        li: usize,
+        floor: &Floor,
+        out: &mut Vec<Committed<M::State, M::Output>>,
+    ) {
+        let observed = self.ship && model.observed(self.lps[li].id);
+        loop {
+            let lp = &mut self.lps[li];
+            if !lp
                 .history
                 .front()
-                .is_some_and(|d| gvt.passed(&d.time, lp.id))
+                .is_some_and(|d| floor.passed(&d.time, lp.id))
             {
-                let d = lp.history.pop_front().expect("a batch to commit");
-                if let Some(what) = d.into_past {
-                    self.fault
-                        .get_or_insert(format!("model bug in a committed batch: {what}"));
-                }
-                self.uncommitted -= 1;
-                self.stats.committed += 1;
-                let state = observed.then(|| match lp.history.front() {
-                    Some(next) => next.pre_state.clone(),
-                    None => lp.state.clone(),
-                });
-                let cs = &mut self.committed_stats;
-                cs.batches += 1;
-                cs.delivered += d.inputs.len() as u64;
-                cs.cancels += u64::from(d.cancel_calls);
-                for (s, kind) in d.sent {
-                    cs.count(usize::from(kind));
-                    // still ahead: it may yet be cancelled by a later batch
-                    if s.retractable && !gvt.passed(&s.time, s.to) {
-                        lp.sends.insert(s.seq, s);
-                    }
-                }
-                for &r in &d.inputs {
-                    self.entries.remove(r);
-                }
-                // a committed cancellation is final: its message needs no name any more
-                for c in &d.cancels {
-                    lp.sends.remove(&c.seq);
-                }
-                // the collector needs only what its sinks see
-                if state.is_some() || !d.output.is_empty() {
-                    out.push(Committed {
-                        time: d.time,
-                        obj: lp.id,
-                        state,
-                        output: d.output,
-                    });
-                }
+                break;
             }
-            if lp.sends.len() > lp.sweep_at {
-                lp.sends.retain(|_, s| !gvt.passed(&s.time, s.to));
-                lp.sweep_at = 2 * lp.sends.len().max(32);
-            }
+            let d = lp.history.pop_front().expect("a batch to commit");
+            let state = observed.then(|| match lp.history.front() {
+                Some(next) => next
+                    .pre_state
+                    .clone()
+                    .expect("an uncommitted batch saved its state"),
+                None => lp.state.clone(),
+            });
+            self.uncommitted -= 1;
+            self.commit(li, d, state, floor, out);
+        }
+    }
+
+    /// Commits every batch before `gvt`: frees its saved state and messages, and returns those
+    /// the collector needs (output, and observed states when the collector wants them), with
+    /// the batches committed early that `gvt` passed, in no particular order.
+    fn fossil_collect(&mut self, model: &M, gvt: Floor) -> Vec<Committed<M::State, M::Output>> {
+        let (mut out, early): (Vec<_>, Vec<_>) = std::mem::take(&mut self.early)
+            .into_iter()
+            .partition(|c| gvt.passed(&c.time, c.obj));
+        self.early = early;
+        let mut still = Vec::with_capacity(self.active.len());
+        for k in 0..self.active.len() {
+            let li = self.active[k] as usize;
+            self.commit_front(model, li, &gvt, &mut out);
+            let lp = &mut self.lps[li];
+            lp.sweep_sends(&gvt);
             if lp.history.is_empty() {
                 lp.active = false;
             } else {
-                still.push(li);
+                still.push(li as u32);
             }
         }
         self.active = still;
@@ -1060,13 +1212,18 @@ impl<M: Model> Worker<M> {
     ) -> Result<(), Stop> {
         let mut buf = Vec::new();
         let mut since = 0u32;
+        self.ship = ship;
+        self.final_ok = cfg.final_batches && fabric.shares_floors();
+        self.flush(fabric);
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
             let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window);
             let mut limit = until.min(window);
+            // short bursts publish floors often, so that the others' batches can run as final
             let burst = match &mut self.chaos {
                 Some(c) => c.rng.gen_range(1..64u32),
+                None if self.final_ok => 4,
                 None => 64,
             };
             let mut ran = 0;
@@ -1078,7 +1235,7 @@ impl<M: Model> Worker<M> {
                     self.artificial_rollback();
                     limit = limit.min(self.gvt.t);
                 }
-                if !self.step(model, limit) {
+                if !self.step(model, fabric, limit) {
                     break;
                 }
                 ran += 1;
@@ -1118,7 +1275,7 @@ impl<M: Model> Worker<M> {
                         self.auto_window = 4.0 * (gvt.t - self.gvt.t);
                     }
                     self.gvt = gvt;
-                    let batches = self.fossil_collect(model, gvt, ship);
+                    let batches = self.fossil_collect(model, gvt);
                     self.round += 1;
                     fabric.commit(Chunk {
                         worker: self.index,

@@ -52,9 +52,22 @@ impl ThreadReduce {
     }
 }
 
+/// A worker's inbox and what bounds it.
+struct Slot<Msg> {
+    /// Ops sent to it, not taken yet.
+    inbox: Vec<Op<Msg>>,
+    /// Below every op in the inbox.
+    inbox_floor: Floor,
+    /// Below everything the worker holds or has yet to send: its published floor, lowered to
+    /// the inbox's when it takes the inbox.
+    floor: Floor,
+    /// Changes so far: a reading of every slot saw one instant if no count moved while it read.
+    version: u64,
+}
+
 /// Workers as threads of this process.
 pub struct ThreadFabric<M: Model> {
-    inboxes: Vec<Mutex<Vec<Op<M::Msg>>>>,
+    slots: Vec<Mutex<Slot<M::Msg>>>,
     reduce: ThreadReduce,
     collector: mpsc::Sender<Chunk<M::State, M::Output>>,
 }
@@ -66,7 +79,16 @@ where
     /// A fabric for `n` workers whose committed chunks go to `collector`.
     pub fn new(n: usize, collector: mpsc::Sender<Chunk<M::State, M::Output>>) -> Self {
         ThreadFabric {
-            inboxes: (0..n).map(|_| Mutex::new(Vec::new())).collect(),
+            slots: (0..n)
+                .map(|_| {
+                    Mutex::new(Slot {
+                        inbox: Vec::new(),
+                        inbox_floor: Floor::INFINITY,
+                        floor: Floor::NEG_INFINITY,
+                        version: 0,
+                    })
+                })
+                .collect(),
             reduce: ThreadReduce::new(n),
             collector,
         }
@@ -80,21 +102,35 @@ where
     M::Output: Send,
 {
     fn send(&self, _from: usize, to: usize, mut ops: Vec<Op<M::Msg>>) {
-        let mut inbox = self.inboxes[to].lock().expect("no thread panicked");
-        if inbox.is_empty() {
-            std::mem::swap(&mut *inbox, &mut ops);
+        let floor = ops
+            .iter()
+            .map(|op| Floor::of(op.time(), op.to()))
+            .fold(Floor::INFINITY, Floor::min);
+        let mut slot = self.slots[to].lock().expect("no thread panicked");
+        let slot = &mut *slot;
+        if slot.inbox.is_empty() {
+            std::mem::swap(&mut slot.inbox, &mut ops);
         } else {
-            inbox.append(&mut ops);
+            slot.inbox.append(&mut ops);
         }
+        slot.inbox_floor = slot.inbox_floor.min(floor);
+        slot.version += 1;
     }
 
     fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
-        let mut inbox = self.inboxes[me].lock().expect("no thread panicked");
-        if into.is_empty() {
-            std::mem::swap(&mut *inbox, into);
-        } else {
-            into.append(&mut inbox);
+        let mut slot = self.slots[me].lock().expect("no thread panicked");
+        let slot = &mut *slot;
+        if slot.inbox.is_empty() {
+            return;
         }
+        if into.is_empty() {
+            std::mem::swap(&mut slot.inbox, into);
+        } else {
+            into.append(&mut slot.inbox);
+        }
+        slot.floor = slot.floor.min(slot.inbox_floor);
+        slot.inbox_floor = Floor::INFINITY;
+        slot.version += 1;
     }
 
     fn reduce(&self, me: usize, local: Reduction) -> Reduction {
@@ -104,6 +140,38 @@ where
     fn commit(&self, chunk: Chunk<M::State, M::Output>) {
         // the collector outlives the workers; if it has gone, nobody wants the output
         let _ = self.collector.send(chunk);
+    }
+
+    fn shares_floors(&self) -> bool {
+        true
+    }
+
+    fn publish(&self, me: usize, floor: Floor) {
+        let mut slot = self.slots[me].lock().expect("no thread panicked");
+        slot.floor = floor;
+        slot.version += 1;
+    }
+
+    fn peers_floor(&self, me: usize) -> Option<Floor> {
+        // an op is always under some floor: in its sender's until it is in an inbox, in the
+        // inbox's until its receiver takes it, and in its receiver's from then on
+        let (mut versions, mut floor) = (0u64, Floor::INFINITY);
+        for (w, slot) in self.slots.iter().enumerate() {
+            let slot = slot.lock().expect("no thread panicked");
+            versions += slot.version;
+            floor = floor.min(slot.inbox_floor);
+            if w != me {
+                floor = floor.min(slot.floor);
+            }
+        }
+        // versions only grow: the same sum on a second reading means no slot changed between
+        // its two readings, so all of them held at one instant between the two passes
+        let again: u64 = self
+            .slots
+            .iter()
+            .map(|slot| slot.lock().expect("no thread panicked").version)
+            .sum();
+        (again == versions).then_some(floor)
     }
 }
 
@@ -497,6 +565,47 @@ mod tests {
             finals,
             ..chunk(worker, u64::MAX, Vec::new())
         }
+    }
+
+    fn at(t: f64) -> VTime {
+        VTime::at(Key::start(t))
+    }
+
+    #[test]
+    fn a_floor_covers_what_workers_hold_and_what_waits_in_inboxes() {
+        let (tx, _rx) = mpsc::channel();
+        let f: ThreadFabric<Numbers> = ThreadFabric::new(3, tx);
+        assert!(Fabric::shares_floors(&f));
+        // a worker that has published nothing covers nothing
+        assert_eq!(f.peers_floor(0), Some(Floor::NEG_INFINITY));
+        f.publish(0, Floor::start(9.0));
+        f.publish(1, Floor::start(5.0));
+        f.publish(2, Floor::start(7.0));
+        assert_eq!(f.peers_floor(0), Some(Floor::start(5.0)));
+        assert_eq!(
+            f.peers_floor(1),
+            Some(Floor::start(7.0)),
+            "a worker's own floor is not its bound"
+        );
+        // worker 1 sends worker 2 an op at t = 3, then moves on: the inbox holds the bound down
+        let anti = |t: f64| Op::Anti {
+            uid: 1,
+            to: 9,
+            time: at(t),
+        };
+        f.send(1, 2, vec![anti(3.0)]);
+        f.publish(1, Floor::start(8.0));
+        assert_eq!(f.peers_floor(0), Some(Floor::of(&at(3.0), 9)));
+        // worker 2 takes it: its own floor drops to the op's until it publishes again
+        let mut got = Vec::new();
+        f.recv(2, &mut got);
+        assert_eq!(got.len(), 1);
+        assert_eq!(f.peers_floor(0), Some(Floor::of(&at(3.0), 9)));
+        f.publish(2, Floor::start(6.0));
+        assert_eq!(f.peers_floor(0), Some(Floor::start(6.0)));
+        // an op waiting for the asking worker itself bounds it too
+        f.send(2, 0, vec![anti(4.0)]);
+        assert_eq!(f.peers_floor(0), Some(Floor::of(&at(4.0), 9)));
     }
 
     #[test]
