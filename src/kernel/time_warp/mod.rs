@@ -26,6 +26,15 @@
 //! cancelled message comes after the cancelling batch in the (virtual time, receiver) order of
 //! batches; otherwise it was already delivered and the cancellation does nothing.
 //!
+//! A batch that comes before every op any other worker may still send its worker is final
+//! already: it runs without saving its object's state and commits at once (with the object's
+//! earlier batches), its output waiting for the first GVT round that passes it. Workers on
+//! threads publish floors for this ([`Fabric::peers_floor`]). Running such safe events without
+//! optimistic bookkeeping is the idea of protocols that mix conservative and optimistic
+//! execution event by event (Jha and Bagrodia, "A unified framework for conservative and
+//! optimistic distributed simulation", PADS 1994; Jefferson and Barnes, "Virtual Time III",
+//! ACM TOMACS 32(4), 2022). With one worker every batch is final.
+//!
 //! GVT (global virtual time) is found in synchronous rounds, as ROSS does: workers stop
 //! processing, drain their inboxes until a reduction says every op sent has been received,
 //! then reduce the first (virtual time, receiver) they still hold a message for, a [`Floor`]:
@@ -847,14 +856,6 @@ impl<M: Model> Worker<M> {
                 uids.push(it.r);
             }
         }
-        let batch: Vec<Envelope<M::Msg>> = uids
-            .iter()
-            .map(|&r| {
-                let e = self.entries.at_mut(r).expect("a valid entry");
-                e.processed = true;
-                e.p.as_ref().expect("a live entry").env.clone()
-            })
-            .collect();
         let li = self.placement.local(to);
         debug_assert!(
             self.lps[li].last_time().is_none_or(|t| *t < time),
@@ -870,6 +871,19 @@ impl<M: Model> Worker<M> {
             // a key deeper than a floor keeps may leave batches of the instant uncommitted
             run_final = self.lps[li].history.is_empty();
         }
+        // a final batch's messages are freed when it commits, straight after it: moved, not copied
+        let batch: Vec<Envelope<M::Msg>> = uids
+            .iter()
+            .map(|&r| {
+                let e = self.entries.at_mut(r).expect("a valid entry");
+                e.processed = true;
+                if run_final {
+                    e.p.take().expect("a live entry").env
+                } else {
+                    e.p.as_ref().expect("a live entry").env.clone()
+                }
+            })
+            .collect();
         let lp = &mut self.lps[li];
         if time.key.depth() > MAX_CASCADE_DEPTH {
             // GVT cannot pass an instant this deep, so it would pile up batches until memory ran out
