@@ -522,9 +522,9 @@ pub struct Worker<M: Model> {
     final_floor: Floor,
     /// Below every op in the outboxes.
     outbox_floor: Floor,
-    /// Batches committed between GVT rounds (run as final), for the chunk of the first round
-    /// whose GVT passes them: the collector puts out a round's batches after the round
-    /// before's, and a final batch may be later than a batch another worker has yet to commit.
+    /// What the collector needs of committed batches, until the chunk of the first GVT round
+    /// that passes them: the collector puts out a round's batches after the round before's,
+    /// and a batch run as final may be later than one another worker commits a round after.
     early: Vec<Committed<M::State, M::Output>>,
 }
 
@@ -865,9 +865,7 @@ impl<M: Model> Worker<M> {
         // ones: commit those, and run this one without saving the state
         let mut run_final = self.final_ok && self.may_run_final(fabric, &time, to);
         if run_final {
-            let mut out = std::mem::take(&mut self.early);
-            self.commit_front(model, li, &Floor::of(&time, to), &mut out);
-            self.early = out;
+            self.commit_front(model, li, &Floor::of(&time, to));
             // a key deeper than a floor keeps may leave batches of the instant uncommitted
             run_final = self.lps[li].history.is_empty();
         }
@@ -957,9 +955,7 @@ impl<M: Model> Worker<M> {
             self.final_floor = Floor::of(&done.time, to);
             let state = (self.ship && model.observed(to)).then(|| lp.state.clone());
             let (gvt, floor) = (self.gvt, self.final_floor);
-            let mut out = std::mem::take(&mut self.early);
-            self.commit(li, done, state, &floor, &mut out);
-            self.early = out;
+            self.commit(li, done, state, &floor);
             self.lps[li].sweep_sends(&gvt);
         } else {
             if !lp.active {
@@ -1092,14 +1088,7 @@ impl<M: Model> Worker<M> {
     /// Commits one batch of local object `li`: counts it, files the sends a later batch may
     /// still cancel (those `floor` has not passed), frees its input records, and keeps for the
     /// collector what its sinks see (`state` is the object's state after it, when observed).
-    fn commit(
-        &mut self,
-        li: usize,
-        d: Done<M>,
-        state: Option<M::State>,
-        floor: &Floor,
-        out: &mut Vec<Committed<M::State, M::Output>>,
-    ) {
+    fn commit(&mut self, li: usize, d: Done<M>, state: Option<M::State>, floor: &Floor) {
         if let Some(what) = d.into_past {
             self.fault
                 .get_or_insert(format!("model bug in a committed batch: {what}"));
@@ -1126,7 +1115,7 @@ impl<M: Model> Worker<M> {
         }
         // the collector needs only what its sinks see
         if state.is_some() || !d.output.is_empty() {
-            out.push(Committed {
+            self.early.push(Committed {
                 time: d.time,
                 obj: lp.id,
                 state,
@@ -1136,13 +1125,7 @@ impl<M: Model> Worker<M> {
     }
 
     /// Commits the batches of local object `li` that `floor` passed, oldest first.
-    fn commit_front(
-        &mut self,
-        model: &M,
-        li: usize,
-        floor: &Floor,
-        out: &mut Vec<Committed<M::State, M::Output>>,
-    ) {
+    fn commit_front(&mut self, model: &M, li: usize, floor: &Floor) {
         let observed = self.ship && model.observed(self.lps[li].id);
         loop {
             let lp = &mut self.lps[li];
@@ -1162,22 +1145,18 @@ impl<M: Model> Worker<M> {
                 None => lp.state.clone(),
             });
             self.uncommitted -= 1;
-            self.commit(li, d, state, floor, out);
+            self.commit(li, d, state, floor);
         }
     }
 
-    /// Commits every batch before `gvt`: frees its saved state and messages, and returns those
-    /// the collector needs (output, and observed states when the collector wants them), with
-    /// the batches committed early that `gvt` passed, in no particular order.
+    /// Commits every batch before `gvt`: frees its saved state and messages, and returns what
+    /// the collector needs of every batch committed so far that `gvt` passed (output, and
+    /// observed states when the collector wants them), in no particular order.
     fn fossil_collect(&mut self, model: &M, gvt: Floor) -> Vec<Committed<M::State, M::Output>> {
-        let (mut out, early): (Vec<_>, Vec<_>) = std::mem::take(&mut self.early)
-            .into_iter()
-            .partition(|c| gvt.passed(&c.time, c.obj));
-        self.early = early;
         let mut still = Vec::with_capacity(self.active.len());
         for k in 0..self.active.len() {
             let li = self.active[k] as usize;
-            self.commit_front(model, li, &gvt, &mut out);
+            self.commit_front(model, li, &gvt);
             let lp = &mut self.lps[li];
             lp.sweep_sends(&gvt);
             if lp.history.is_empty() {
@@ -1187,6 +1166,11 @@ impl<M: Model> Worker<M> {
             }
         }
         self.active = still;
+        // a batch run as final may come after one another worker commits only in a later round
+        let (out, early) = std::mem::take(&mut self.early)
+            .into_iter()
+            .partition(|c| gvt.passed(&c.time, c.obj));
+        self.early = early;
         // dead messages whose cancellation is committed can never come back to life (judged by
         // simulation time: cancellations are kept by the time of their batch)
         let gvt = gvt.t;
