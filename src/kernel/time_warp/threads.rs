@@ -608,6 +608,65 @@ mod tests {
         assert_eq!(f.peers_floor(0), Some(Floor::of(&at(4.0), 9)));
     }
 
+    /// The threads' fabric, but claiming that nothing can ever come: every batch runs final.
+    struct Liar<M: Model>(ThreadFabric<M>);
+
+    impl<M: Model> Fabric<M> for Liar<M>
+    where
+        M::Msg: Send,
+        M::State: Send,
+        M::Output: Send,
+    {
+        fn send(&self, from: usize, to: usize, ops: Vec<Op<M::Msg>>) {
+            self.0.send(from, to, ops);
+        }
+        fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
+            self.0.recv(me, into);
+        }
+        fn reduce(&self, me: usize, local: Reduction) -> Reduction {
+            self.0.reduce(me, local)
+        }
+        fn commit(&self, chunk: Chunk<M::State, M::Output>) {
+            self.0.commit(chunk);
+        }
+        fn shares_floors(&self) -> bool {
+            true
+        }
+        fn peers_floor(&self, _: usize) -> Option<Floor> {
+            Some(Floor::INFINITY)
+        }
+    }
+
+    #[test]
+    fn an_op_below_a_final_batch_stops_the_run() {
+        use crate::model::phold::{Phold, PholdConfig};
+        let cfg = PholdConfig {
+            objects: 96,
+            events_per_object: 4,
+            remote: 0.3,
+            partitions: 2,
+            lookahead: 0.0,
+            mean: 1.0,
+            seed: 11,
+        };
+        let (model, states) = Phold::new(cfg);
+        let worker_of: Vec<u32> = (0..96).map(|o| model.partition(o)).collect();
+        let tw_cfg = TwConfig {
+            workers: 2,
+            chaos: Some(5),
+            ..TwConfig::default()
+        };
+        let mut tw = TimeWarp::new(model, states, at(0.0), &worker_of, tw_cfg);
+        let (tx, rx) = mpsc::channel();
+        let liar = Liar(ThreadFabric::new(2, tx));
+        let mut failed: Option<TwError<()>> = None;
+        tw.drive(&liar, &rx, 30.0, &mut |_, _, _| Ok(()), &mut failed);
+        match failed {
+            Some(TwError::Failed(m)) => assert!(m.contains("ran as final"), "{m}"),
+            other => panic!("a lying fabric went unnoticed: {other:?}"),
+        }
+    }
+
     #[test]
     fn final_states_wait_for_the_last_round() {
         let mut c: Collector<Numbers> = Collector::new(vec![0, 0]);
