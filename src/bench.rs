@@ -54,6 +54,9 @@ pub struct BenchArgs {
     /// Simulated time of the Time Warp runs.
     #[arg(long = "tw-until", default_value_t = 1.0)]
     pub tw_until: f64,
+    /// Pure Time Warp in the Time Warp and PHOLD runs: no batch runs as final.
+    #[arg(long = "tw-pure")]
+    pub tw_pure: bool,
     /// PHOLD objects (16 messages each, remote 0.1, 2 partitions, lookahead 0.1).
     #[arg(long = "phold-objects", default_value_t = 1024)]
     pub phold_objects: u32,
@@ -362,8 +365,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             a.tw_until
         );
         println!(
-            "{:>9} {:>8} {:>9} {:>9} {:>11} {:>8}  digest",
-            "balls", "workers", "wall s", "speed-up", "efficiency", "remote"
+            "{:>9} {:>8} {:>9} {:>9} {:>11} {:>8} {:>6}  digest",
+            "balls", "workers", "wall s", "speed-up", "efficiency", "remote", "final"
         );
     }
     let mut time_warp = Vec::new();
@@ -371,12 +374,12 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         let rows = fastest(
             a.repeat,
             |rows: &Vec<TwRow>| rows.iter().map(|r| r.seconds).sum(),
-            || measure_time_warp(n, a.tw_until),
+            || measure_time_warp(n, a.tw_until, a.tw_pure),
         )?;
         for r in rows {
             if !a.json {
                 println!(
-                    "{:>9} {:>8} {:>9.3} {:>9.2} {:>11.3} {:>8.3}  {}",
+                    "{:>9} {:>8} {:>9.3} {:>9.2} {:>11.3} {:>8.3} {:>6.3}  {}",
                     r.balls,
                     if r.workers == 0 {
                         "seq".to_string()
@@ -387,6 +390,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                     r.speedup,
                     r.efficiency,
                     r.remote_fraction,
+                    r.final_fraction,
                     r.digest
                 );
             }
@@ -407,6 +411,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     for workers in [None, Some(1), Some(2)] {
         let tw = workers.map(|w| crate::kernel::time_warp::TwConfig {
             workers: w,
+            final_batches: !a.tw_pure,
             ..Default::default()
         });
         phold.push(crate::model::phold::run(phold_cfg.clone(), 20.0, tw)?);
@@ -547,13 +552,17 @@ pub struct TwRow {
     pub efficiency: f64,
     /// Messages that crossed workers over all messages.
     pub remote_fraction: f64,
+    /// Batches run as final (without state saving) over batches committed; 0 for the
+    /// sequential engine.
+    pub final_fraction: f64,
     /// The final state digest (the same for every executor, or the bench fails).
     pub digest: String,
 }
 
 /// Runs the sectored gas (`--sectors auto`) of `balls` balls until `until` on the sequential
-/// objects engine and under Time Warp on 1 and 2 workers; fails if any digest differs.
-pub fn measure_time_warp(balls: usize, until: f64) -> Result<Vec<TwRow>, String> {
+/// objects engine and under Time Warp on 1 and 2 workers (`pure`: no batch run as final);
+/// fails if any digest differs.
+pub fn measure_time_warp(balls: usize, until: f64, pure: bool) -> Result<Vec<TwRow>, String> {
     use crate::run::{execute, EngineKind, RunConfig, SectorChoice};
     let (n_balls, scenario) = thesis_gas(balls, None)?;
     let mut rows: Vec<TwRow> = Vec::new();
@@ -565,6 +574,7 @@ pub fn measure_time_warp(balls: usize, until: f64) -> Result<Vec<TwRow>, String>
             w => EngineKind::TimeWarp {
                 tw: crate::kernel::time_warp::TwConfig {
                     workers: w,
+                    final_batches: !pure,
                     ..Default::default()
                 },
                 delay: crate::model::pool::NvDelay::Exact,
@@ -603,6 +613,10 @@ pub fn measure_time_warp(balls: usize, until: f64) -> Result<Vec<TwRow>, String>
             events: report.outcome.events.total(),
             efficiency: tw["efficiency"].as_f64().unwrap_or(1.0),
             remote_fraction: tw["remote_fraction"].as_f64().unwrap_or(0.0),
+            final_fraction: match (tw["final_batches"].as_f64(), tw["committed"].as_f64()) {
+                (Some(f), Some(c)) if c > 0.0 => f / c,
+                _ => 0.0,
+            },
             digest,
         });
     }
@@ -628,7 +642,7 @@ mod tests {
 
     #[test]
     fn time_warp_rows_agree_with_the_sequential_run() {
-        let rows = measure_time_warp(100, 0.5).unwrap();
+        let rows = measure_time_warp(100, 0.5, false).unwrap();
         assert_eq!(
             rows.iter().map(|r| r.workers).collect::<Vec<_>>(),
             [0, 1, 2]
@@ -641,6 +655,11 @@ mod tests {
             .all(|r| r.events == rows[0].events && r.events > 0));
         assert_eq!(rows[0].speedup, 1.0);
         assert_eq!(rows[1].efficiency, 1.0);
+        // alone, a worker runs every batch as final; pure, none
+        assert_eq!((rows[0].final_fraction, rows[1].final_fraction), (0.0, 1.0));
+        let pure = measure_time_warp(100, 0.5, true).unwrap();
+        assert!(pure.iter().all(|r| r.final_fraction == 0.0));
+        assert!(pure.iter().all(|r| r.digest == rows[0].digest));
     }
 
     #[test]
