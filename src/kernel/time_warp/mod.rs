@@ -525,7 +525,7 @@ pub struct Worker<M: Model> {
     /// What the collector needs of committed batches, until the chunk of the first GVT round
     /// that passes them: the collector puts out a round's batches after the round before's,
     /// and a batch run as final may be later than one another worker commits a round after.
-    early: Vec<Committed<M::State, M::Output>>,
+    to_ship: Vec<Committed<M::State, M::Output>>,
 }
 
 /// Why a worker stopped early.
@@ -595,7 +595,7 @@ impl<M: Model> Worker<M> {
             bound_wait: 0,
             final_floor: Floor::NEG_INFINITY,
             outbox_floor: Floor::INFINITY,
-            early: Vec::new(),
+            to_ship: Vec::new(),
         }
     }
 
@@ -865,9 +865,13 @@ impl<M: Model> Worker<M> {
         // ones: commit those, and run this one without saving the state
         let mut run_final = self.final_ok && self.may_run_final(fabric, &time, to);
         if run_final {
-            self.commit_front(model, li, &Floor::of(&time, to));
+            let here = Floor::of(&time, to);
+            self.commit_front(model, li, &here);
             // a key deeper than a floor keeps may leave batches of the instant uncommitted
             run_final = self.lps[li].history.is_empty();
+            if run_final {
+                self.final_floor = here;
+            }
         }
         // a final batch's messages are freed when it commits, straight after it: moved, not copied
         let batch: Vec<Envelope<M::Msg>> = uids
@@ -952,7 +956,6 @@ impl<M: Model> Worker<M> {
         self.stats.processed += 1;
         if run_final {
             self.stats.final_batches += 1;
-            self.final_floor = Floor::of(&done.time, to);
             let state = (self.ship && model.observed(to)).then(|| lp.state.clone());
             let (gvt, floor) = (self.gvt, self.final_floor);
             self.commit(li, done, state, &floor);
@@ -1115,7 +1118,7 @@ impl<M: Model> Worker<M> {
         }
         // the collector needs only what its sinks see
         if state.is_some() || !d.output.is_empty() {
-            self.early.push(Committed {
+            self.to_ship.push(Committed {
                 time: d.time,
                 obj: lp.id,
                 state,
@@ -1167,10 +1170,10 @@ impl<M: Model> Worker<M> {
         }
         self.active = still;
         // a batch run as final may come after one another worker commits only in a later round
-        let (out, early) = std::mem::take(&mut self.early)
+        let (out, later) = std::mem::take(&mut self.to_ship)
             .into_iter()
             .partition(|c| gvt.passed(&c.time, c.obj));
-        self.early = early;
+        self.to_ship = later;
         // dead messages whose cancellation is committed can never come back to life (judged by
         // simulation time: cancellations are kept by the time of their batch)
         let gvt = gvt.t;
