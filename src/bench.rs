@@ -563,13 +563,14 @@ pub struct TwRow {
 /// objects engine and under Time Warp on 1 and 2 workers (`pure`: no batch run as final);
 /// fails if any digest differs.
 pub fn measure_time_warp(balls: usize, until: f64, pure: bool) -> Result<Vec<TwRow>, String> {
-    use crate::run::{execute, EngineKind, RunConfig, SectorChoice};
+    use crate::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
     let (n_balls, scenario) = thesis_gas(balls, None)?;
     let mut rows: Vec<TwRow> = Vec::new();
     for workers in [0, 1, 2] {
         let engine = match workers {
             0 => EngineKind::Sectored {
                 sectors: SectorChoice::Auto,
+                news: FixedNews::default(),
             },
             w => EngineKind::TimeWarp {
                 tw: crate::kernel::time_warp::TwConfig {
@@ -579,6 +580,7 @@ pub fn measure_time_warp(balls: usize, until: f64, pure: bool) -> Result<Vec<TwR
                 },
                 delay: crate::model::pool::NvDelay::Exact,
                 sectors: Some(SectorChoice::Auto),
+                news: FixedNews::default(),
             },
         };
         let cfg = RunConfig {

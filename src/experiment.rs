@@ -23,7 +23,7 @@
 use crate::analytic::{self, ModelParams};
 use crate::engine::{Event, EventKind, Ignore, Observer, RunError, World};
 use crate::model::pool::NvDelay;
-use crate::run::{execute, EngineKind, RunConfig, SectorChoice};
+use crate::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
 use crate::scenario::builtin::{self, Params};
 use crate::scenario::Scenario;
 use plotters::coord::Shift;
@@ -494,8 +494,10 @@ fn objects(
         Setting::NoSectors => EngineKind::Objects {
             delay: NvDelay::Exact,
         },
+        // the thesis' message counts: every ball tells every fixed object
         Setting::Grid(k) => EngineKind::Sectored {
             sectors: SectorChoice::Grid(k, k),
+            news: FixedNews::Thesis,
         },
     };
     let cfg = RunConfig {

@@ -8,7 +8,7 @@ use poolsim::engine::{Event, Observer, RunError, World};
 use poolsim::kernel::time_warp::{self, TwConfig};
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};
-use poolsim::run::{execute, EngineKind, RunConfig, SectorChoice};
+use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
 use poolsim::scenario::{self, builtin, Scenario};
 use std::fs::File;
 use std::io::{BufWriter, IsTerminal};
@@ -123,6 +123,10 @@ struct RunArgs {
     /// Delay of NewVelocity messages (objects engines).
     #[arg(long = "newvelocity-delay")]
     newvelocity_delay: Option<String>,
+    /// Which balls tell cushions, pockets and corners of a new trajectory on a sectored table:
+    /// near (those in sectors within reach; the default) or thesis (all: fig. 15's counts).
+    #[arg(long = "fixed-news")]
+    fixed_news: Option<String>,
     /// Time step of the time-step engine.
     #[arg(long, allow_negative_numbers = true)]
     dt: Option<f64>,
@@ -253,6 +257,7 @@ fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
         gvt_interval: None,
         tw_pure: false,
         newvelocity_delay: a.newvelocity_delay.clone(),
+        fixed_news: None,
         dt: a.dt,
         quiet: true,
     };
@@ -509,6 +514,17 @@ fn load(spec: &str, gen: &GenArgs) -> Result<Scenario, Failure> {
     scenario::load(spec, &gen.params()).map_err(|e| usage(e.to_string()))
 }
 
+/// `--fixed-news`: near (the default) or thesis.
+fn fixed_news(arg: Option<&str>) -> Result<FixedNews, Failure> {
+    match arg {
+        None | Some("near") => Ok(FixedNews::Near),
+        Some("thesis") => Ok(FixedNews::Thesis),
+        Some(other) => Err(usage(format!(
+            "--fixed-news: expected near or thesis, got `{other}`"
+        ))),
+    }
+}
+
 /// `--newvelocity-delay`: absent or 0 is exact; `auto` is the thesis' choice (4.4): a ball at the
 /// fastest initial speed moves 1% of the smallest diameter in the delay.
 fn nv_delay(arg: Option<&str>, s: &Scenario) -> Result<NvDelay, Failure> {
@@ -620,7 +636,10 @@ fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
                 Some(sectors) => {
                     poolsim::run::sector_layout(scenario, sectors)
                         .map_err(|e| usage(format!("--sectors: {e}")))?;
-                    Ok(EngineKind::Sectored { sectors })
+                    Ok(EngineKind::Sectored {
+                        sectors,
+                        news: fixed_news(a.fixed_news.as_deref())?,
+                    })
                 }
             }
         }
@@ -641,6 +660,7 @@ fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
                 tw: tw_config(a)?,
                 delay,
                 sectors,
+                news: fixed_news(a.fixed_news.as_deref())?,
             })
         }
         other => Err(usage(format!(
@@ -762,6 +782,19 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         EngineKind::Objects { .. } | EngineKind::Sectored { .. } | EngineKind::TimeWarp { .. }
     );
     let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
+    let sectored = matches!(
+        engine,
+        EngineKind::Sectored { .. }
+            | EngineKind::TimeWarp {
+                sectors: Some(_),
+                ..
+            }
+    );
+    if a.fixed_news.is_some() && !sectored {
+        return Err(usage(
+            "--fixed-news: only sectored runs take it (--engine objects or time-warp with --sectors)",
+        ));
+    }
     for (flag, given) in [
         ("--sectors", a.sectors.is_some() && !objects),
         (
@@ -988,6 +1021,7 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
         gvt_interval: None,
         tw_pure: false,
         newvelocity_delay: a.newvelocity_delay.clone(),
+        fixed_news: None,
         dt: None,
         quiet: true,
     };
@@ -1024,7 +1058,14 @@ fn demo(json: bool, out: &std::path::Path) -> Result<(), Failure> {
     let cfg = poolsim::render::RenderConfig {
         check: true,
         sectors: Some(sectors),
-        ..poolsim::render::RenderConfig::new(EngineKind::Sectored { sectors }, scenario.until, 0.1)
+        ..poolsim::render::RenderConfig::new(
+            EngineKind::Sectored {
+                sectors,
+                news: FixedNews::default(),
+            },
+            scenario.until,
+            0.1,
+        )
     };
     let (rec, line) = render_to(&scenario, &cfg, out)?;
     let mut summary = rec.summary;

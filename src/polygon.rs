@@ -238,6 +238,17 @@ impl Polygon {
         self.boundary_distance2(p)
     }
 
+    /// The squared distance (length²) from the segment `a`–`b` to the closed polygon: zero when
+    /// they meet.
+    pub fn distance2_to_segment(&self, a: Vec2, b: Vec2) -> f64 {
+        if self.contains(a) || self.contains(b) {
+            return 0.0;
+        }
+        self.edges()
+            .map(|(c, d)| segment_segment_distance2(a, b, c, d))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// The squared distance from `p` to the nearest edge.
     fn boundary_distance2(&self, p: Vec2) -> f64 {
         self.edges()
@@ -940,6 +951,18 @@ mod tests {
         // the thesis' closed corner list is fine
         let p = Polygon::new(vec![v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.0, 0.0)]).unwrap();
         assert_eq!(p.points.len(), 3);
+    }
+
+    #[test]
+    fn distance_to_a_segment() {
+        let sq = square();
+        // crossing the square with both ends outside, along an edge, from inside, and apart
+        assert_eq!(sq.distance2_to_segment(v(-5.0, 5.0), v(15.0, 5.0)), 0.0);
+        assert_eq!(sq.distance2_to_segment(v(-5.0, 0.0), v(15.0, 0.0)), 0.0);
+        assert_eq!(sq.distance2_to_segment(v(5.0, 5.0), v(5.0, 5.0)), 0.0);
+        assert_eq!(sq.distance2_to_segment(v(-5.0, 13.0), v(15.0, 13.0)), 9.0);
+        // the nearest point is a corner of the square
+        assert_eq!(sq.distance2_to_segment(v(13.0, 14.0), v(20.0, 14.0)), 25.0);
     }
 
     #[test]

@@ -6,7 +6,7 @@
 
 use crate::experiment::{register_font, write_png};
 use crate::model::pool::NvDelay;
-use crate::run::{reverse, EngineKind, ReversalReport, SectorChoice};
+use crate::run::{reverse, EngineKind, FixedNews, ReversalReport, SectorChoice};
 use crate::scenario::builtin::{build, Params};
 use plotters::prelude::*;
 use std::path::Path;
@@ -30,6 +30,7 @@ fn engines() -> [EngineKind; 3] {
         },
         EngineKind::Sectored {
             sectors: SectorChoice::Grid(2, 2),
+            news: FixedNews::default(),
         },
     ]
 }

@@ -10,6 +10,8 @@ use crate::engine::time_step::{self, TimeStep};
 use crate::engine::{BallState, Event, Frame, Observer, Outcome, RunError, Span, Table, World};
 use crate::kernel::time_warp::{TwConfig, TwStats};
 use crate::model::pool::NvDelay;
+/// Which balls tell the fixed objects of a sectored table (re-exported for engine choices).
+pub use crate::model::sectored::FixedNews;
 use crate::model::sectored::Layout;
 use crate::output::{digest, events_json};
 use crate::physics::kinetic_energy;
@@ -38,6 +40,8 @@ pub enum EngineKind {
     Sectored {
         /// How the table is cut into sectors.
         sectors: SectorChoice,
+        /// Which balls tell the fixed objects of their trajectories.
+        news: FixedNews,
     },
     /// The objects run optimistically in parallel by Time Warp, plain or sectored.
     TimeWarp {
@@ -47,6 +51,8 @@ pub enum EngineKind {
         delay: NvDelay,
         /// How the table is cut into sectors; `None`: not sectored.
         sectors: Option<SectorChoice>,
+        /// Which balls tell the fixed objects of their trajectories (sectored).
+        news: FixedNews,
     },
 }
 
@@ -223,17 +229,23 @@ pub fn execute(
             let mut e = Objects::new(scenario, delay, cfg.span);
             e.run(cfg.until, &mut sinks)?
         }
-        EngineKind::Sectored { sectors } => {
+        EngineKind::Sectored { sectors, news } => {
             if cfg.span.frame_time.is_some() {
                 return Err(RunError::Input(
                     "the sectored engine draws no frames itself (poolsim render does)".into(),
                 ));
             }
-            let layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
+            let mut layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
+            layout.fixed_news = news;
             let mut e = Objects::sectored(scenario, layout, cfg.span);
             e.run(cfg.until, &mut sinks)?
         }
-        EngineKind::TimeWarp { tw, delay, sectors } => {
+        EngineKind::TimeWarp {
+            tw,
+            delay,
+            sectors,
+            news,
+        } => {
             let mut e = match sectors {
                 None => Objects::plain_on(scenario, delay, cfg.span, Some(tw)),
                 Some(_) if cfg.span.frame_time.is_some() => {
@@ -242,7 +254,8 @@ pub fn execute(
                     ))
                 }
                 Some(choice) => {
-                    let layout = sector_layout(scenario, choice).map_err(RunError::Input)?;
+                    let mut layout = sector_layout(scenario, choice).map_err(RunError::Input)?;
+                    layout.fixed_news = news;
                     Objects::sectored_on(scenario, layout, cfg.span, Some(tw))
                 }
             };

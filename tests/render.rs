@@ -200,7 +200,10 @@ fn every_engine_draws_the_same_picture() {
     let mut cfg = config(EngineKind::EventList, 1.0, 0.25);
     cfg.sectors = Some(grid);
     let a = record(&gas, &cfg).expect("event-list records");
-    cfg.engine = EngineKind::Sectored { sectors: grid };
+    cfg.engine = EngineKind::Sectored {
+        sectors: grid,
+        news: poolsim::run::FixedNews::Near,
+    };
     let b = record(&gas, &cfg).expect("sectored records");
     assert_eq!(a.shots.len(), 5);
     for k in 0..a.shots.len() {
@@ -226,7 +229,14 @@ fn the_history_gives_the_engines_frames_and_the_messages_add_up() {
     let grid = SectorChoice::Grid(2, 2);
     let rec = record(
         &scenario("gas"),
-        &config(EngineKind::Sectored { sectors: grid }, 2.0, 0.5),
+        &config(
+            EngineKind::Sectored {
+                sectors: grid,
+                news: poolsim::run::FixedNews::Near,
+            },
+            2.0,
+            0.5,
+        ),
     )
     .expect("records");
     let h = rec.history.as_ref().expect("history");
@@ -253,7 +263,14 @@ fn the_history_gives_the_engines_frames_and_the_messages_add_up() {
 #[test]
 fn the_page_is_one_file_with_its_data_and_no_network() {
     let grid = SectorChoice::Grid(2, 2);
-    let mut cfg = config(EngineKind::Sectored { sectors: grid }, 4.0, 0.1);
+    let mut cfg = config(
+        EngineKind::Sectored {
+            sectors: grid,
+            news: poolsim::run::FixedNews::Near,
+        },
+        4.0,
+        0.1,
+    );
     cfg.sectors = Some(grid);
     let rec = record(&scenario("gas"), &cfg).expect("records");
     let page = html::page(&rec);
@@ -485,7 +502,14 @@ fn the_page_in_a_browser_shows_the_trace_s_positions() {
     };
     let dir = tempfile::tempdir().expect("a temporary folder");
     let grid = SectorChoice::Grid(2, 2);
-    let mut cfg = config(EngineKind::Sectored { sectors: grid }, 4.0, 0.1);
+    let mut cfg = config(
+        EngineKind::Sectored {
+            sectors: grid,
+            news: poolsim::run::FixedNews::Near,
+        },
+        4.0,
+        0.1,
+    );
     cfg.sectors = Some(grid);
     // Without its history the page moves balls linearly between frames: exact for plate 1
     // between 1.0 and 1.5, before the collision at 1.6.

@@ -38,7 +38,16 @@ fn thesis_4_7_returns_every_ball_to_its_start() {
     assert_eq!(a.max_velocity_error, b.max_velocity_error);
     for k in [1, 2, 5] {
         let sectors = poolsim::run::SectorChoice::Grid(k, k);
-        let d = reverse(&s, EngineKind::Sectored { sectors }, 3.0, true).unwrap();
+        let d = reverse(
+            &s,
+            EngineKind::Sectored {
+                sectors,
+                news: poolsim::run::FixedNews::Near,
+            },
+            3.0,
+            true,
+        )
+        .unwrap();
         assert_eq!(a.events, d.events, "{k} sectors per side");
         assert_eq!(a.max_position_error, d.max_position_error);
     }
@@ -53,6 +62,7 @@ fn thesis_4_7_returns_every_ball_to_its_start() {
             tw,
             delay: poolsim::model::pool::NvDelay::Exact,
             sectors,
+            news: poolsim::run::FixedNews::Near,
         };
         let e = reverse(&s, engine, 3.0, true).unwrap();
         assert_eq!(a.events, e.events, "time warp {sectors:?}");
@@ -68,6 +78,7 @@ fn a_pocketed_ball_comes_back_out_at_the_mirror_time() {
     let s = build("plate1", &Params::default()).unwrap();
     let sectored = EngineKind::Sectored {
         sectors: poolsim::run::SectorChoice::Grid(3, 3),
+        news: poolsim::run::FixedNews::Near,
     };
     for engine in [EngineKind::EventList, objects(), sectored] {
         let cfg = RunConfig {

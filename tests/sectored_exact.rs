@@ -4,7 +4,7 @@
 
 use poolsim::geometry::Vec2;
 use poolsim::output::{TraceLine, TraceRecorder};
-use poolsim::run::{execute, EngineKind, RunConfig, SectorChoice};
+use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
 use poolsim::scenario::{builtin, load, Scenario, SectorSpec};
 use proptest::prelude::*;
 
@@ -24,13 +24,23 @@ fn run(s: &Scenario, engine: EngineKind) -> (Vec<TraceLine>, serde_json::Value) 
 
 fn assert_same(s: &Scenario, sectors: SectorChoice) {
     let (want, ws) = run(s, EngineKind::EventList);
-    let (got, gs) = run(s, EngineKind::Sectored { sectors });
-    assert_eq!(got, want, "{} with {sectors:?}: traces differ", s.name);
-    assert_eq!(
-        gs["final_state_digest"], ws["final_state_digest"],
-        "{} with {sectors:?}",
-        s.name
-    );
+    let mut sent = Vec::new();
+    for news in [FixedNews::Near, FixedNews::Thesis] {
+        let (got, gs) = run(s, EngineKind::Sectored { sectors, news });
+        assert_eq!(
+            got, want,
+            "{} with {sectors:?}, {news:?}: traces differ",
+            s.name
+        );
+        assert_eq!(
+            gs["final_state_digest"], ws["final_state_digest"],
+            "{} with {sectors:?}, {news:?}",
+            s.name
+        );
+        sent.push(gs["messages"]["NewVelocity"].as_u64().unwrap_or(0));
+    }
+    // fixed objects hear only from balls within reach of them: never more news than in fig. 15
+    assert!(sent[0] <= sent[1], "{} with {sectors:?}: {sent:?}", s.name);
 }
 
 const GRIDS: [u32; 9] = [1, 2, 3, 4, 5, 7, 10, 16, 25];
@@ -79,6 +89,7 @@ fn a_fast_ball_cannot_tunnel_through_a_ball_on_a_sector_boundary() {
         &s,
         EngineKind::Sectored {
             sectors: SectorChoice::Scenario,
+            news: FixedNews::Near,
         },
     );
     assert_eq!(trace.len(), 1);
@@ -196,12 +207,12 @@ proptest! {
         prop_assume!(s.validate().is_ok());
         let (want, ws) = run(&s, EngineKind::EventList);
         let (got, gs) = if which == 3 {
-            run(&s, EngineKind::Sectored { sectors: SectorChoice::Grid(nx, ny) })
+            run(&s, EngineKind::Sectored { sectors: SectorChoice::Grid(nx, ny), news: FixedNews::Near })
         } else {
             let (lo, hi) = s.bounds();
             let span = hi - lo;
             let polys = layouts(span.x, span.y).swap_remove(which);
-            run(&with_layout(&s, polys), EngineKind::Sectored { sectors: SectorChoice::Scenario })
+            run(&with_layout(&s, polys), EngineKind::Sectored { sectors: SectorChoice::Scenario, news: FixedNews::Near })
         };
         prop_assert_eq!(got, want);
         prop_assert_eq!(&gs["final_state_digest"], &ws["final_state_digest"]);

@@ -5,7 +5,7 @@
 use poolsim::kernel::time_warp::TwConfig;
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{TraceLine, TraceRecorder};
-use poolsim::run::{execute, EngineKind, RunConfig, SectorChoice};
+use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
 use poolsim::scenario::{builtin, load, Scenario};
 
 struct Run {
@@ -33,7 +33,10 @@ fn sequential(sectors: Option<SectorChoice>) -> EngineKind {
         None => EngineKind::Objects {
             delay: NvDelay::Exact,
         },
-        Some(sectors) => EngineKind::Sectored { sectors },
+        Some(sectors) => EngineKind::Sectored {
+            sectors,
+            news: FixedNews::Near,
+        },
     }
 }
 
@@ -58,6 +61,7 @@ fn pure_or_not(
         },
         delay: NvDelay::Exact,
         sectors,
+        news: FixedNews::Near,
     }
 }
 
@@ -167,6 +171,7 @@ fn a_tight_memory_budget_rolls_back_and_stays_exact() {
         },
         delay: NvDelay::Exact,
         sectors: Some(SectorChoice::Grid(4, 4)),
+        news: FixedNews::Near,
     };
     let got = run(&s, engine);
     assert_eq!(got.trace, want.trace);
@@ -190,6 +195,7 @@ fn an_instant_commits_as_it_goes() {
         },
         delay: NvDelay::Exact,
         sectors,
+        news: FixedNews::Near,
     };
     let got = run(&s, engine);
     assert_eq!(got.summary["events"]["total"], 0);

@@ -6,7 +6,7 @@
 //!  Ball ───────────────► its Sectors ─────────────► their Balls ─────────────► Ball (and itself)
 //!    │                        │        NewVelocity                SectorEntry
 //!    │                        └──────────────────► adjacent Sectors ─────────► Ball (and itself)
-//!    │  NewVelocity                                  SectorDeparture
+//!    │  NewVelocity (in reach)                       SectorDeparture
 //!    └──────────────► Cushions, Pockets, Corners     Sector ────────────────► Ball (and itself)
 //! ```
 //!
@@ -14,8 +14,14 @@
 //! (keyed before everything else of that instant) and leaves after everything of the instant it
 //! stops touching. Any two balls that collide touch a common sector at that moment, so one of them
 //! hears of the other's trajectory there in time: through a velocity change relayed by a sector
-//! they share, or when one enters a sector the other is in. Fixed objects hear of every change
-//! directly, as in the plain simulation.
+//! they share, or when one enters a sector the other is in.
+//!
+//! Fixed objects hear from the balls directly, as in the plain simulation, but (beyond the
+//! thesis, [`FixedNews::Near`]) only from balls in sectors within reach of them: a ball tells
+//! them when it changes course in such a sector or enters one. A fixed object may then hold a
+//! collision computed from a trajectory the ball has since left; the ball finds it stale by its
+//! version, as below, and lets it pass. [`FixedNews::Thesis`] tells every fixed object of every
+//! change, for the thesis' message counts.
 //!
 //! Beyond the thesis: a ball may hold a collision that a ball it no longer shares a sector with
 //! scheduled, so it would never hear that the other changed course. Each Collision therefore
@@ -42,7 +48,20 @@ pub struct Layout {
     pub polys: Vec<Polygon>,
     /// For each sector, the sectors whose boundaries meet its own (an edge or a corner).
     pub adjacent: Vec<Vec<u32>>,
+    /// Which balls tell the cushions, pockets and corners of their trajectories.
+    pub fixed_news: FixedNews,
     index: BoxIndex,
+}
+
+/// Which balls tell a fixed object (cushion, pocket, corner) of a new trajectory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FixedNews {
+    /// Those in sectors within reach of it: a ball that changes course there, or that enters
+    /// such a sector, tells it. The same collisions, with a fraction of the messages.
+    #[default]
+    Near,
+    /// Every ball, at every change, as the thesis' fig. 15 (for its message counts).
+    Thesis,
 }
 
 /// Sectors bucketed by bounding box on a uniform grid over the table.
@@ -126,6 +145,7 @@ impl Layout {
         Ok(Layout {
             polys,
             adjacent,
+            fixed_news: FixedNews::default(),
             index,
         })
     }
@@ -155,6 +175,44 @@ impl Layout {
             .filter(|&k| polygon::touches(&self.polys[k as usize], centre, r))
             .collect()
     }
+}
+
+/// For each sector, the fixed objects a ball touching it may reach before it leaves the sectors
+/// near them, and the fixed objects no sector is near (all of them with [`FixedNews::Thesis`]). A ball whose disk touches a fixed object
+/// at time t has its centre in some sector within its radius of the contact point, and was in
+/// sectors within twice its radius for a time r / v before: so a fixed object within
+/// `2 rmax` of a sector (plus rounding) hears of every trajectory that can reach it, from the
+/// ball when it changes course in such a sector or enters one.
+fn near_fixed(table: &Table, layout: &Layout, rmax: f64) -> (Vec<Vec<u32>>, Vec<u32>) {
+    let size = (table.hi - table.lo).norm();
+    let reach = 2.0 * rmax + 1e-9 * size;
+    let mut near = vec![Vec::new(); layout.polys.len()];
+    let mut far = Vec::new();
+    let fixed = table.n_balls..table.n_balls + table.n_fixed();
+    if layout.fixed_news == FixedNews::Thesis {
+        return (near, fixed.collect());
+    }
+    for id in fixed {
+        let (a, b) = match table.fixed(id) {
+            Fixed::Cushion(k) => (table.cushions[k as usize].0, table.cushions[k as usize].1),
+            Fixed::Pocket(k) => table.pockets[k as usize],
+            Fixed::Corner(k) => (table.corners[k as usize].0, table.corners[k as usize].0),
+        };
+        let d = Vec2::new(reach, reach);
+        let lo = Vec2::new(a.x.min(b.x), a.y.min(b.y)) - d;
+        let hi = Vec2::new(a.x.max(b.x), a.y.max(b.y)) + d;
+        let mut any = false;
+        for k in layout.index.candidates(lo, hi) {
+            if layout.polys[k as usize].distance2_to_segment(a, b) <= reach * reach {
+                near[k as usize].push(id);
+                any = true;
+            }
+        }
+        if !any {
+            far.push(id);
+        }
+    }
+    (near, far)
 }
 
 /// Messages of the sectored simulation.
@@ -278,6 +336,10 @@ pub struct Sectored {
     table: Table,
     layout: Layout,
     span: Span,
+    /// For each sector (from 0), the fixed objects within reach of a ball touching it.
+    near_fixed: Vec<Vec<u32>>,
+    /// Fixed objects near no sector: every ball tells them every trajectory.
+    far_fixed: Vec<u32>,
 }
 
 impl Sectored {
@@ -327,11 +389,15 @@ impl Sectored {
                 planned: Vec::new(),
             });
         }
+        let rmax = s.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+        let (near_fixed, far_fixed) = near_fixed(&table, &layout, rmax);
         (
             Sectored {
                 table,
                 layout,
                 span,
+                near_fixed,
+                far_fixed,
             },
             states,
         )
@@ -351,13 +417,32 @@ impl Sectored {
         self.table.n_balls + self.table.n_fixed()
     }
 
-    fn fixed_ids(&self) -> std::ops::Range<u32> {
-        self.table.n_balls..self.first_sector()
+    /// The fixed objects a ball in `sectors` could reach before it leaves them, in order.
+    fn fixed_near(&self, sectors: &[u32]) -> Vec<u32> {
+        let first = self.first_sector();
+        let mut fs = self.far_fixed.clone();
+        for &s in sectors {
+            fs.extend_from_slice(&self.near_fixed[(s - first) as usize]);
+        }
+        fs.sort_unstable();
+        fs.dedup();
+        fs
     }
 
-    /// Tells every fixed object ball `me`'s trajectory.
-    fn tell_fixed(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, info: &Arc<BallInfo>) {
-        for f in self.fixed_ids() {
+    /// Tells ball `me`'s trajectory to the fixed objects it could reach from `sectors`.
+    fn tell_fixed(
+        &self,
+        ctx: &mut Ctx<'_, Sectored>,
+        me: u32,
+        info: &Arc<BallInfo>,
+        sectors: &[u32],
+    ) {
+        self.tell(ctx, me, info, &self.fixed_near(sectors));
+    }
+
+    /// Tells ball `me`'s trajectory to the fixed objects `fs`.
+    fn tell(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, info: &Arc<BallInfo>, fs: &[u32]) {
+        for &f in fs {
             ctx.send_now(
                 f,
                 SecMsg::NewVelocity {
@@ -427,6 +512,11 @@ impl Sectored {
     ) {
         let mut changed = false;
         let mut seen_balls: Vec<u32> = Vec::new();
+        // the fixed objects that know the trajectory already, when the ball may enter sectors
+        let entering = batch
+            .iter()
+            .any(|e| matches!(e.msg, SecMsg::SectorEntry { .. }));
+        let knew = entering.then(|| self.fixed_near(sectors));
         for env in batch {
             match &env.msg {
                 SecMsg::Collision {
@@ -550,10 +640,15 @@ impl Sectored {
                     },
                 );
             }
-            self.tell_fixed(ctx, me, info);
+            self.tell_fixed(ctx, me, info, sectors);
             if info.pocket.is_some() {
                 sectors.clear();
             }
+        } else if let Some(knew) = knew {
+            // a fixed object newly in reach hears of the trajectory on entry
+            let mut now_near = self.fixed_near(sectors);
+            now_near.retain(|f| knew.binary_search(f).is_err());
+            self.tell(ctx, me, info, &now_near);
         }
     }
 
@@ -889,7 +984,7 @@ impl Model for Sectored {
                     },
                 );
             }
-            self.tell_fixed(ctx, me, info);
+            self.tell_fixed(ctx, me, info, sectors);
             if let Some(t) = self.span.reverse_at {
                 ctx.send_at(me, VTime::at(Key::at(t, REVERSAL)), SecMsg::ReverseYourself);
             }
@@ -915,5 +1010,36 @@ impl Model for Sectored {
                 self.sector_batch(ctx, me, members, planned, batch)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::builtin::{build, Params};
+
+    #[test]
+    fn fixed_objects_hear_from_the_sectors_within_reach() {
+        // a gas on a square table of four cushions, cut into 5 x 5 sectors
+        let s = build("gas", &Params::default()).unwrap();
+        let table = Table::new(&s);
+        let mut layout = Layout::grid(&table, 5, 5);
+        let w = (table.hi.x - table.lo.x) / 5.0;
+        // balls of radius w / 2 reach a sector's width in from a cushion, and not the middle
+        let (near, far) = near_fixed(&table, &layout, 0.5 * w);
+        assert!(far.is_empty());
+        assert!(near[12].is_empty(), "{:?}", near[12]);
+        assert_eq!(near[0].len(), 2);
+        assert_eq!(near[6].len(), 2);
+        assert_eq!(near[7].len(), 1);
+        // smaller balls reach only the sectors along the cushions
+        let (near, _) = near_fixed(&table, &layout, 0.45 * w);
+        assert!(near[6].is_empty() && near[12].is_empty());
+        assert_eq!(near[0].len(), 2);
+        assert_eq!(near[1].len(), 1);
+        layout.fixed_news = FixedNews::Thesis;
+        let (near, far) = near_fixed(&table, &layout, 30.0);
+        assert!(near.iter().all(Vec::is_empty));
+        assert_eq!(far.len(), table.n_fixed() as usize);
     }
 }

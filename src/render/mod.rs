@@ -334,14 +334,21 @@ fn chunked(
 ) -> Result<Option<Vec<(Frame, EventCounts, Vec<(&'static str, u64)>)>>, RunError> {
     let mut e = match engine {
         EngineKind::Objects { delay } => Objects::new(scenario, delay, Span::default()),
-        EngineKind::Sectored { sectors } => {
-            let layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
+        EngineKind::Sectored { sectors, news } => {
+            let mut layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
+            layout.fixed_news = news;
             Objects::sectored(scenario, layout, Default::default())
         }
-        EngineKind::TimeWarp { tw, delay, sectors } => match sectors {
+        EngineKind::TimeWarp {
+            tw,
+            delay,
+            sectors,
+            news,
+        } => match sectors {
             None => Objects::plain_on(scenario, delay, Span::default(), Some(tw)),
             Some(choice) => {
-                let layout = sector_layout(scenario, choice).map_err(RunError::Input)?;
+                let mut layout = sector_layout(scenario, choice).map_err(RunError::Input)?;
+                layout.fixed_news = news;
                 Objects::sectored_on(scenario, layout, Span::default(), Some(tw))
             }
         },
@@ -376,7 +383,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
     let times = frame_times(cfg.until, cfg.frame_time);
     let drawn = match (cfg.sectors, cfg.engine) {
         (None, _) => None,
-        (Some(_), EngineKind::Sectored { sectors }) | (Some(sectors), _) => {
+        (Some(_), EngineKind::Sectored { sectors, .. }) | (Some(sectors), _) => {
             Some(sector_layout(scenario, sectors).map_err(RunError::Input)?)
         }
     };
