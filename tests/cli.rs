@@ -799,6 +799,29 @@ fn usage_errors_say_what_is_wrong_on_one_line() {
     );
     assert!(bad_usage(&["bench", "--phold-objects", "1"]).contains("--phold-objects"));
     assert!(bad_usage(&["phold", "--objects", "4294967295"]).contains("events in flight"));
+    let line = bad_usage(&[
+        "run",
+        "gas",
+        "--sectors",
+        "2",
+        "--engine",
+        "objects",
+        "--fixed-news",
+        "all",
+    ]);
+    assert!(
+        line.contains("--fixed-news") && line.contains("`all`"),
+        "{line}"
+    );
+    let line = bad_usage(&[
+        "run",
+        "gas",
+        "--engine",
+        "objects",
+        "--fixed-news",
+        "thesis",
+    ]);
+    assert!(line.contains("sectored runs"), "{line}");
 }
 
 /// `--check` also checks the state the run ends in: with a NewVelocity delay longer than the
