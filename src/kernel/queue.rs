@@ -173,6 +173,16 @@ impl<T: Ord> Queue<T> {
         self.instant.retain(&mut keep);
         self.later.retain(&mut keep);
     }
+
+    /// Every item held, in no particular order.
+    pub fn iter(&self) -> impl Iterator<Item = &T> {
+        let i = &self.instant;
+        i.run
+            .iter()
+            .chain(i.side.iter())
+            .chain(i.fresh.iter())
+            .chain(self.later.iter())
+    }
 }
 
 #[cfg(test)]

@@ -4,9 +4,9 @@
 //! ```text
 //!   worker 0                         worker 1
 //!   ┌───────────────────────┐  ops   ┌───────────────────────┐
-//!   │ objects (LPs):        │ ─────► │ entries: uid → count  │
-//!   │  state, history of    │ ◄───── │ heap of live, un-     │
-//!   │  done batches         │        │ processed messages    │
+//!   │ objects (LPs):        │ ─────► │ heap of messages not  │
+//!   │  state, history of    │ ◄───── │ handled yet; marks by │
+//!   │  done batches         │        │ uid: anti, cancelled  │
 //!   └───────────┬───────────┘        └───────────┬───────────┘
 //!               └──── GVT round (reduce) ────────┘──► committed chunks ─► collector ─► sink
 //! ```
@@ -17,10 +17,13 @@
 //! everything the undone batches sent is retracted by anti-messages (aggressive cancellation).
 //!
 //! Transport names every message by a `uid` that is never reused (the sender's object index and
-//! a counter that is not rolled back), so an anti-message finds its message whatever the order
-//! of arrival: an entry counts positives minus anti-messages, and model-level cancellations
-//! (`Ctx::cancel`) minus their undoing; a message is live when it has one positive and no
-//! cancellation. Every change of liveness in an object's past rolls the object back to it.
+//! a counter that is not rolled back). A message is in one place at a time: on its way, in its
+//! worker's heap, in the batch that handled it (a rollback puts it back in the heap), or set
+//! aside while cancelled. An anti-message, or a model-level cancellation (`Ctx::cancel`) and its
+//! undoing, is a mark on the uid that the worker reads when the message reaches the top of its
+//! heap or arrives, whatever the order of arrival (`marks.rs`); most messages are never marked,
+//! and the sequential executor's cost per message is one heap item too. Every change of
+//! liveness in an object's past rolls the object back to it.
 //!
 //! A model cancellation takes effect only where the sequential executor's would: when the
 //! cancelled message comes after the cancelling batch in the (virtual time, receiver) order of
@@ -47,11 +50,11 @@
 pub mod mpi;
 pub mod threads;
 
-mod entries;
 mod floor;
+mod marks;
 
-use entries::{Entries, Ref};
 pub use floor::Floor;
+use marks::{Mark, Marks};
 
 use super::queue::Queue;
 use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
@@ -301,54 +304,34 @@ pub trait Fabric<M: Model>: Sync {
     }
 }
 
-/// A heap entry: a live message's delivery order and where its record is.
-struct Item {
-    time: VTime,
-    to: u32,
-    priority: u8,
-    from: u32,
-    seq: u64,
-    r: Ref,
+/// A message waiting in a worker's heap, with its transport name.
+struct Item<Msg> {
+    uid: u64,
+    p: Pending<Msg>,
 }
 
-impl Item {
-    fn of<M>(r: Ref, p: &Pending<M>) -> Item {
-        Item {
-            time: p.time.clone(),
-            to: p.to,
-            priority: p.priority,
-            from: p.env.from,
-            seq: p.env.seq,
-            r,
-        }
-    }
-
-    fn order(&self, o: &Item) -> Ordering {
-        self.time
-            .cmp(&o.time)
-            .then(self.to.cmp(&o.to))
-            .then(self.priority.cmp(&o.priority))
-            .then(self.from.cmp(&o.from))
-            .then(self.seq.cmp(&o.seq))
-            .then(self.r.uid.cmp(&o.r.uid))
+impl<Msg> Item<Msg> {
+    /// The delivery order; two sends of one message (the second after a rollback) by uid.
+    fn order(&self, o: &Self) -> Ordering {
+        self.p.order(&o.p).then(self.uid.cmp(&o.uid))
     }
 }
 
-impl PartialEq for Item {
+impl<Msg> PartialEq for Item<Msg> {
     fn eq(&self, o: &Self) -> bool {
         self.order(o) == Ordering::Equal
     }
 }
 
-impl Eq for Item {}
+impl<Msg> Eq for Item<Msg> {}
 
-impl PartialOrd for Item {
+impl<Msg> PartialOrd for Item<Msg> {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
         Some(self.cmp(o))
     }
 }
 
-impl Ord for Item {
+impl<Msg> Ord for Item<Msg> {
     fn cmp(&self, o: &Self) -> Ordering {
         o.order(self)
     }
@@ -358,13 +341,18 @@ impl Ord for Item {
 #[derive(Clone, Debug)]
 struct Sent {
     uid: u64,
-    /// Its record's slot, when the receiver is on this worker.
-    slot: Option<u32>,
     seq: u64,
     to: u32,
     /// Whether its sender may cancel it: only those are filed once committed.
     retractable: bool,
     time: VTime,
+}
+
+/// What a batch keeps of each message it handled, besides the envelope, to put it back.
+struct Input {
+    uid: u64,
+    priority: u8,
+    retractable: bool,
 }
 
 /// A batch an object ran that is not committed yet.
@@ -373,7 +361,9 @@ struct Done<M: Model> {
     /// The object's state before it; `None` for a batch run as final.
     pre_state: Option<M::State>,
     pre_seq: u64,
-    inputs: Vec<Ref>,
+    /// The messages it handled: their names, and the envelopes the model saw.
+    inputs: Vec<Input>,
+    batch: Vec<Envelope<M::Msg>>,
     sent: Vec<(Sent, u16)>,
     cancels: Vec<Sent>,
     cancel_calls: u32,
@@ -481,12 +471,14 @@ pub struct Worker<M: Model> {
     index: usize,
     placement: std::sync::Arc<Placement>,
     lps: Vec<Lp<M>>,
-    entries: Entries<M::Msg>,
-    heap: Queue<Item>,
+    /// Live and marked messages not handled yet.
+    heap: Queue<Item<M::Msg>>,
+    /// Anti-messages and cancellations, and cancelled messages set aside.
+    marks: Marks<M::Msg>,
     /// The key of the batch run last: messages for it go to the pending set's instant tier.
     current: Key,
-    /// Ops for this worker's objects, with the slot of their message's record when known.
-    local_ops: Vec<(Op<M::Msg>, Option<u32>)>,
+    /// Ops for this worker's objects.
+    local_ops: Vec<Op<M::Msg>>,
     outbox: Vec<Vec<Op<M::Msg>>>,
     /// Chaos mode: its random stream and the ops it holds back.
     chaos: Option<Chaos<M::Msg>>,
@@ -500,13 +492,10 @@ pub struct Worker<M: Model> {
     round: u64,
     stats: TwStats,
     committed_stats: MessageStats,
-    /// Memory samples (uncommitted batches plus entries) after each GVT round.
+    /// Memory samples (uncommitted batches plus messages held) after each GVT round.
     samples: Vec<u64>,
     /// A failure found while committing; the run stops at the next GVT round.
     fault: Option<String>,
-    /// Messages left dead (cancelled, annulled), with their times: fossil collection frees them
-    /// once nothing can revive them.
-    graveyard: Vec<(f64, Ref)>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
     /// Whether batches may run as final ([`TwConfig::final_batches`]).
@@ -563,8 +552,8 @@ impl<M: Model> Worker<M> {
                 })
                 .collect(),
             placement,
-            entries: Entries::with_capacity(RESERVED_PER_OBJECT * n_objects),
             heap: Queue::with_capacity(RESERVED_PER_OBJECT * n_objects),
+            marks: Marks::default(),
             current: Key::start(f64::NEG_INFINITY),
             local_ops: Vec::new(),
             outbox: (0..workers).map(|_| Vec::new()).collect(),
@@ -587,7 +576,6 @@ impl<M: Model> Worker<M> {
             committed_stats: MessageStats::default(),
             samples: Vec::new(),
             fault: None,
-            graveyard: Vec::new(),
             active: Vec::new(),
             final_ok: false,
             ship: false,
@@ -612,14 +600,11 @@ impl<M: Model> Worker<M> {
                 self.committed_stats.count(model.kind(&p.env.msg));
                 let lp = &mut self.lps[k];
                 let uid = lp.next_uid();
-                let slot = (self.placement.worker(p.to) == self.index)
-                    .then(|| self.entries.reserve(uid).slot);
                 if p.retractable {
                     lp.sends.insert(
                         p.env.seq,
                         Sent {
                             uid,
-                            slot,
                             seq: p.env.seq,
                             to: p.to,
                             retractable: true,
@@ -627,7 +612,7 @@ impl<M: Model> Worker<M> {
                         },
                     );
                 }
-                self.route(Op::Msg { uid, p }, slot);
+                self.route(Op::Msg { uid, p });
             }
         }
         self.drain_local();
@@ -648,16 +633,16 @@ impl<M: Model> Worker<M> {
     /// Accepts ops handed over outside a fabric (at set-up).
     pub fn accept(&mut self, ops: Vec<Op<M::Msg>>) {
         for op in ops {
-            self.apply(op, None);
+            self.apply(op);
         }
         self.drain_local();
     }
 
     /// Live messages waiting (not handled) on this worker.
     pub fn pending_len(&self) -> usize {
-        self.entries
+        self.heap
             .iter()
-            .filter(|e| e.live() && !e.processed)
+            .filter(|it| self.marks.of(it.uid, it.p.retractable) == Mark::Live)
             .count()
     }
 
@@ -666,8 +651,8 @@ impl<M: Model> Worker<M> {
         &self.samples
     }
 
-    /// Sends an op on its way; `slot` is its message's record here, when the sender knows it.
-    fn route(&mut self, op: Op<M::Msg>, slot: Option<u32>) {
+    /// Sends an op on its way.
+    fn route(&mut self, op: Op<M::Msg>) {
         let w = self.placement.worker(op.to());
         match &op {
             Op::Msg { .. } => {
@@ -680,7 +665,7 @@ impl<M: Model> Worker<M> {
             Op::Cancel { .. } => {}
         }
         if w == self.index {
-            self.local_ops.push((op, slot));
+            self.local_ops.push(op);
         } else {
             let f = Floor::of(op.time(), op.to());
             self.outbox_floor = self.outbox_floor.min(f);
@@ -690,58 +675,75 @@ impl<M: Model> Worker<M> {
     }
 
     fn drain_local(&mut self) {
-        while let Some((op, slot)) = self.local_ops.pop() {
-            self.apply(op, slot);
+        while let Some(op) = self.local_ops.pop() {
+            self.apply(op);
         }
     }
 
-    /// Applies one op to its entry (at `slot` when known), rolling the receiver back if its past
-    /// changes.
-    fn apply(&mut self, op: Op<M::Msg>, slot: Option<u32>) {
-        let to = op.to();
-        let (uid, time) = match &op {
-            Op::Msg { uid, p } => (*uid, p.time.clone()),
-            Op::Anti { uid, time, .. } | Op::Cancel { uid, time, .. } => (*uid, time.clone()),
-        };
-        if self.final_floor.reaches(&time, to) {
+    /// Applies one op, rolling its receiver back if the op changes what the receiver's past
+    /// should have seen.
+    fn apply(&mut self, op: Op<M::Msg>) {
+        let (to, time) = (op.to(), op.time());
+        if self.final_floor.reaches(time, to) {
             self.fault.get_or_insert(format!(
                 "time warp: an op for object {to} at t = {} came after a later batch ran as final",
                 time.t()
             ));
         }
-        let r = self.entries.open(uid, slot);
-        let e = self.entries.at_mut(r).expect("an open record");
-        let before = e.live();
+        let li = self.placement.local(to);
         match op {
-            Op::Msg { p, .. } => {
-                e.pos += 1;
-                e.p = (e.pos == 1).then_some(p);
+            Op::Msg { uid, p } => {
+                if !self.marks.arrives(uid) {
+                    return; // its anti-message came first
+                }
+                if p.retractable && self.marks.cancelled(uid) {
+                    self.marks.set_aside(uid, p, Mark::Cancelled);
+                    return;
+                }
+                if self.lps[li].last_time().is_some_and(|t| *t >= p.time) {
+                    self.rollback(li, &p.time); // a straggler
+                }
+                self.push(Item { uid, p });
             }
-            Op::Anti { .. } => {
-                e.pos -= 1;
-                e.p = None;
+            Op::Anti { uid, time, .. } => {
+                // a cancelled message was handled by no batch that stands
+                let unseen = self.marks.cancelled(uid);
+                if self.marks.annul(uid) || unseen {
+                    return;
+                }
+                // if a batch handled it, the message is back in the heap after this, and the
+                // mark drops it there
+                if self.lps[li].last_time().is_some_and(|t| *t >= time) {
+                    self.rollback(li, &time);
+                }
             }
-            Op::Cancel { sign, at, .. } => e.cancel(at, sign),
+            Op::Cancel {
+                uid,
+                time,
+                sign,
+                at,
+                ..
+            } => {
+                let before = self.marks.cancelled(uid);
+                let back = self.marks.cancel(uid, time.t(), at, sign);
+                if before != self.marks.cancelled(uid)
+                    && self.lps[li].last_time().is_some_and(|t| *t >= time)
+                {
+                    self.rollback(li, &time);
+                }
+                if let Some(p) = back {
+                    self.push(Item { uid, p });
+                }
+            }
         }
-        let after = e.live();
-        if e.empty() {
-            self.entries.remove(r);
-        } else if !after {
-            self.graveyard.push((time.t(), r));
-        }
-        if before != after {
-            let li = self.placement.local(to);
-            if self.lps[li].last_time().is_some_and(|t| *t >= time) {
-                self.rollback(li, &time);
-            }
-            if after {
-                let e = self.entries.at(r).expect("a live entry is held");
-                let p = e.p.as_ref().expect("a live entry holds its message");
-                let in_instant = p.time.key == self.current;
-                self.heap.push(Item::of(r, p), in_instant);
-            }
-        }
-        self.stats.peak_entries = self.stats.peak_entries.max(self.entries.len() as u64);
+        let held = self.heap.len() + self.marks.set_aside_len();
+        self.stats.peak_entries = self.stats.peak_entries.max(held as u64);
+    }
+
+    /// Puts a message in the heap, in the instant's tier if it is for the key being run.
+    fn push(&mut self, it: Item<M::Msg>) {
+        let in_instant = it.p.time.key == self.current;
+        self.heap.push(it, in_instant);
     }
 
     /// Undoes every batch of local object `li` at `time` or later.
@@ -754,14 +756,16 @@ impl<M: Model> Worker<M> {
             self.stats.rolled_back += 1;
             lp.state = d.pre_state.expect("an uncommitted batch saved its state");
             lp.seq = d.pre_seq;
-            for r in d.inputs {
-                if let Some(e) = self.entries.at_mut(r) {
-                    e.processed = false;
-                    if e.live() {
-                        let p = e.p.as_ref().expect("a live entry holds its message");
-                        self.heap.push(Item::of(r, p), false);
-                    }
-                }
+            let to = lp.id;
+            for (i, env) in d.inputs.into_iter().zip(d.batch) {
+                let p = Pending {
+                    time: d.time.clone(),
+                    to,
+                    priority: i.priority,
+                    retractable: i.retractable,
+                    env,
+                };
+                self.heap.push(Item { uid: i.uid, p }, false);
             }
             for (s, _) in d.sent {
                 let op = Op::Anti {
@@ -769,7 +773,7 @@ impl<M: Model> Worker<M> {
                     to: s.to,
                     time: s.time,
                 };
-                self.route(op, s.slot);
+                self.route(op);
             }
             for c in d.cancels {
                 let op = Op::Cancel {
@@ -779,31 +783,22 @@ impl<M: Model> Worker<M> {
                     sign: -1,
                     at: d.time.t(),
                 };
-                self.route(op, c.slot);
+                self.route(op);
             }
         }
     }
 
-    /// Whether a heap item still names a live, unhandled message.
-    fn valid(&self, it: &Item) -> bool {
-        self.entries
-            .at(it.r)
-            .is_some_and(|e| e.live() && !e.processed)
-    }
-
-    /// The smallest time of a live, unhandled message here (stale heap items dropped).
+    /// The smallest time of a live message waiting here (marked ones taken off the heap).
     fn next_time(&mut self) -> Option<f64> {
-        while let Some(top) = self.heap.peek() {
-            let valid = self
-                .entries
-                .at(top.r)
-                .is_some_and(|e| e.live() && !e.processed);
-            if valid {
-                return Some(top.time.t());
+        loop {
+            let top = self.heap.peek()?;
+            let mark = self.marks.of(top.uid, top.p.retractable);
+            if mark == Mark::Live {
+                return Some(top.p.time.t());
             }
-            self.heap.pop();
+            let it = self.heap.pop().expect("a top");
+            self.marks.set_aside(it.uid, it.p, mark);
         }
-        None
     }
 
     /// Whether the batch of `to` at `time` may run as final: no op another worker may still
@@ -842,18 +837,31 @@ impl<M: Model> Worker<M> {
             _ => return false,
         }
         let first = self.heap.pop().expect("a valid top");
-        let (time, to) = (first.time.clone(), first.to);
+        let (time, to) = (first.p.time.clone(), first.p.to);
         if self.current != time.key {
             self.current = time.key.clone();
         }
-        let mut uids = vec![first.r];
+        let mut inputs = vec![Input {
+            uid: first.uid,
+            priority: first.p.priority,
+            retractable: first.p.retractable,
+        }];
+        let mut batch = vec![first.p.env];
         while let Some(top) = self.heap.peek() {
-            if top.time != time || top.to != to {
+            if top.p.time != time || top.p.to != to {
                 break;
             }
             let it = self.heap.pop().expect("a top");
-            if self.valid(&it) && uids.last() != Some(&it.r) {
-                uids.push(it.r);
+            match self.marks.of(it.uid, it.p.retractable) {
+                Mark::Live => {
+                    inputs.push(Input {
+                        uid: it.uid,
+                        priority: it.p.priority,
+                        retractable: it.p.retractable,
+                    });
+                    batch.push(it.p.env);
+                }
+                mark => self.marks.set_aside(it.uid, it.p, mark),
             }
         }
         let li = self.placement.local(to);
@@ -873,19 +881,6 @@ impl<M: Model> Worker<M> {
                 self.final_floor = here;
             }
         }
-        // a final batch's messages are freed when it commits, straight after it: moved, not copied
-        let batch: Vec<Envelope<M::Msg>> = uids
-            .iter()
-            .map(|&r| {
-                let e = self.entries.at_mut(r).expect("a valid entry");
-                e.processed = true;
-                if run_final {
-                    e.p.take().expect("a live entry").env
-                } else {
-                    e.p.as_ref().expect("a live entry").env.clone()
-                }
-            })
-            .collect();
         let lp = &mut self.lps[li];
         if time.key.depth() > MAX_CASCADE_DEPTH {
             // GVT cannot pass an instant this deep, so it would pile up batches until memory ran out
@@ -905,18 +900,15 @@ impl<M: Model> Worker<M> {
         let mut sent_recs = Vec::with_capacity(sent.len());
         for p in sent {
             let uid = lp.next_uid();
-            let slot =
-                (self.placement.worker(p.to) == self.index).then(|| self.entries.reserve(uid).slot);
             let s = Sent {
                 uid,
-                slot,
                 seq: p.env.seq,
                 to: p.to,
                 retractable: p.retractable,
                 time: p.time.clone(),
             };
             sent_recs.push((s, model.kind(&p.env.msg) as u16));
-            ops.push((Op::Msg { uid, p }, slot));
+            ops.push(Op::Msg { uid, p });
         }
         let mut cancels = Vec::new();
         for h in &cancelled {
@@ -940,13 +932,14 @@ impl<M: Model> Worker<M> {
                 sign: 1,
                 at: time.t(),
             };
-            ops.push((op, c.slot));
+            ops.push(op);
         }
         let done = Done {
             time,
             pre_state,
             pre_seq,
-            inputs: uids,
+            inputs,
+            batch,
             sent: sent_recs,
             cancels,
             cancel_calls: cancelled.len() as u32,
@@ -969,8 +962,8 @@ impl<M: Model> Worker<M> {
             self.uncommitted += 1;
             self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
         }
-        for (op, slot) in ops {
-            self.route(op, slot);
+        for op in ops {
+            self.route(op);
         }
         self.drain_local();
         true
@@ -983,7 +976,7 @@ impl<M: Model> Worker<M> {
         if self.next_time().is_none_or(|t| t <= self.gvt.t) {
             return;
         }
-        let t = self.heap.peek().expect("a valid top").time.clone();
+        let t = self.heap.peek().expect("a valid top").p.time.clone();
         for li in 0..self.lps.len() {
             if self.lps[li].last_time().is_some_and(|x| *x >= t) {
                 self.stats.artificial_rollbacks += 1;
@@ -1000,7 +993,7 @@ impl<M: Model> Worker<M> {
         match &mut self.chaos {
             None => {
                 for op in buf.drain(..) {
-                    self.apply(op, None);
+                    self.apply(op);
                 }
             }
             Some(Chaos { rng, held }) => {
@@ -1023,7 +1016,7 @@ impl<M: Model> Worker<M> {
                     due.swap(i, j);
                 }
                 for op in due {
-                    self.apply(op, None);
+                    self.apply(op);
                 }
             }
         }
@@ -1049,7 +1042,7 @@ impl<M: Model> Worker<M> {
         let mut m = match self.next_time() {
             Some(_) => {
                 let top = self.heap.peek().expect("a valid top");
-                Floor::of(&top.time, top.to)
+                Floor::of(&top.p.time, top.p.to)
             }
             None => Floor::INFINITY,
         };
@@ -1100,7 +1093,7 @@ impl<M: Model> Worker<M> {
         let lp = &mut self.lps[li];
         let cs = &mut self.committed_stats;
         cs.batches += 1;
-        cs.delivered += d.inputs.len() as u64;
+        cs.delivered += d.batch.len() as u64;
         cs.cancels += u64::from(d.cancel_calls);
         for (s, kind) in d.sent {
             cs.count(usize::from(kind));
@@ -1108,9 +1101,6 @@ impl<M: Model> Worker<M> {
             if s.retractable && !floor.passed(&s.time, s.to) {
                 lp.sends.insert(s.seq, s);
             }
-        }
-        for &r in &d.inputs {
-            self.entries.remove(r);
         }
         // a committed cancellation is final: its message needs no name any more
         for c in &d.cancels {
@@ -1174,28 +1164,16 @@ impl<M: Model> Worker<M> {
             .into_iter()
             .partition(|c| gvt.passed(&c.time, c.obj));
         self.to_ship = later;
-        // dead messages whose cancellation is committed can never come back to life (judged by
-        // simulation time: cancellations are kept by the time of their batch)
-        let gvt = gvt.t;
-        let held = &mut self.entries;
-        let graveyard = &mut self.graveyard;
-        graveyard.retain(|&(t, r)| {
-            // a message cancelled by a committed batch, or any dead message before GVT (nothing
-            // for it can be in flight then), is dead for ever
-            let gone = |e: &entries::Entry<M::Msg>| !e.live() && (t < gvt || e.dead_for_good(gvt));
-            if held.at(r).is_some_and(gone) {
-                held.remove(r);
-            }
-            t >= gvt && held.at(r).is_some()
-        });
-        // heap items of freed messages wait for their time; drop them when they outnumber the rest
-        if self.heap.len() > 2 * self.entries.len() + 1024 {
-            let entries = &self.entries;
+        self.marks.collect(gvt.t);
+        // marked messages wait in the heap for their time; drop those that are gone for good
+        // when the marks outnumber the rest
+        if self.marks.pending_marks() > self.heap.len() / 2 + 1024 {
+            let marks = &mut self.marks;
             self.heap
-                .retain(|it| entries.at(it.r).is_some_and(|e| e.live() && !e.processed));
+                .retain(|it| marks.keeps(it.uid, it.p.retractable, gvt.t));
         }
-        self.samples
-            .push(self.uncommitted as u64 + self.entries.len() as u64);
+        let held = self.heap.len() + self.marks.set_aside_len();
+        self.samples.push((self.uncommitted + held) as u64);
         out
     }
 

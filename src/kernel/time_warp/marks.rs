@@ -1,0 +1,258 @@
+//! What a worker knows of its messages besides the messages themselves. A message is in one
+//! place at a time: on its way, in the worker's heap, in the batch that handled it, or set aside
+//! here while cancelled. Anti-messages and model cancellations are marks on its uid that the
+//! worker reads when the message reaches the top of its heap, as the sequential executor reads
+//! its set of cancelled handles: most messages are never marked, and cost no lookup by name.
+
+use super::super::Pending;
+use rustc_hash::{FxHashMap, FxHashSet};
+use smallvec::SmallVec;
+
+/// Model cancellations of one message, minus their undoing.
+struct Cancels {
+    /// The message's simulation time: once GVT passes it, nothing can revive or cancel it.
+    t: f64,
+    /// Net cancellations by the simulation time of the cancelling batch (never zero).
+    by: SmallVec<[(f64, i32); 1]>,
+}
+
+/// How a message stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mark {
+    /// To be delivered.
+    Live,
+    /// Its anti-message came: it is gone for good.
+    Annulled,
+    /// Cancelled by its sender: set aside until the cancellation is undone or committed.
+    Cancelled,
+}
+
+/// The marks of one worker's messages.
+pub struct Marks<Msg> {
+    /// Anti-messages whose message has not been dropped yet (it is in the heap or on its way).
+    annulled: FxHashSet<u64>,
+    /// Model cancellations, by the uid of the cancelled message.
+    cancels: FxHashMap<u64, Cancels>,
+    /// Cancelled messages taken off the heap, by uid: undoing the cancellation brings them back.
+    dead: FxHashMap<u64, Pending<Msg>>,
+}
+
+impl<Msg> Default for Marks<Msg> {
+    fn default() -> Self {
+        Marks {
+            annulled: FxHashSet::default(),
+            cancels: FxHashMap::default(),
+            dead: FxHashMap::default(),
+        }
+    }
+}
+
+impl<Msg> Marks<Msg> {
+    /// How message `uid` stands (`retractable`: whether its sender may cancel it).
+    #[inline]
+    pub fn of(&self, uid: u64, retractable: bool) -> Mark {
+        if !self.annulled.is_empty() && self.annulled.contains(&uid) {
+            Mark::Annulled
+        } else if retractable && self.cancelled(uid) {
+            Mark::Cancelled
+        } else {
+            Mark::Live
+        }
+    }
+
+    /// Whether a model cancellation of `uid` stands.
+    #[inline]
+    pub fn cancelled(&self, uid: u64) -> bool {
+        !self.cancels.is_empty() && self.cancels.contains_key(&uid)
+    }
+
+    /// Takes a message that is not live off the heap's hands: an annulled one is dropped (its
+    /// anti-message is spent), a cancelled one set aside.
+    pub fn set_aside(&mut self, uid: u64, p: Pending<Msg>, mark: Mark) {
+        match mark {
+            Mark::Annulled => {
+                self.annulled.remove(&uid);
+            }
+            Mark::Cancelled => {
+                self.dead.insert(uid, p);
+            }
+            Mark::Live => unreachable!("a live message is delivered, not set aside"),
+        }
+    }
+
+    /// A message arriving: false if its anti-message came first (both are then spent).
+    pub fn arrives(&mut self, uid: u64) -> bool {
+        self.annulled.is_empty() || !self.annulled.remove(&uid)
+    }
+
+    /// An anti-message: drops its message if it is set aside here, else marks it, to be dropped
+    /// when it reaches the top of the heap or arrives. True when it was set aside (no batch can
+    /// have handled it).
+    pub fn annul(&mut self, uid: u64) -> bool {
+        if self.dead.remove(&uid).is_some() {
+            return true;
+        }
+        self.annulled.insert(uid);
+        false
+    }
+
+    /// Counts a cancellation of message `uid` (at simulation time `t`) by a batch at `at`
+    /// (`sign` 1) or its undoing (-1). Returns the message if the cancellation no longer
+    /// stands and the message was set aside.
+    pub fn cancel(&mut self, uid: u64, t: f64, at: f64, sign: i8) -> Option<Pending<Msg>> {
+        let c = self.cancels.entry(uid).or_insert_with(|| Cancels {
+            t,
+            by: SmallVec::new(),
+        });
+        match c.by.iter().position(|b| b.0.to_bits() == at.to_bits()) {
+            Some(k) => {
+                c.by[k].1 += i32::from(sign);
+                if c.by[k].1 == 0 {
+                    c.by.swap_remove(k);
+                }
+            }
+            None => c.by.push((at, i32::from(sign))),
+        }
+        if c.by.is_empty() {
+            self.cancels.remove(&uid);
+            return self.dead.remove(&uid);
+        }
+        None
+    }
+
+    /// Cancelled messages set aside.
+    pub fn set_aside_len(&self) -> usize {
+        self.dead.len()
+    }
+
+    /// Marks waiting for messages still in the heap or on their way.
+    pub fn pending_marks(&self) -> usize {
+        self.annulled.len() + self.cancels.len()
+    }
+
+    /// Whether a heap item stays: drops (and unmarks) an annulled message, and a cancelled one
+    /// whose cancellation a batch before `gvt` made (committed: it can no longer be undone).
+    pub fn keeps(&mut self, uid: u64, retractable: bool, gvt: f64) -> bool {
+        match self.of(uid, retractable) {
+            Mark::Live => true,
+            Mark::Annulled => {
+                self.annulled.remove(&uid);
+                false
+            }
+            Mark::Cancelled => {
+                if self.committed(uid, gvt) {
+                    self.cancels.remove(&uid);
+                    false
+                } else {
+                    true
+                }
+            }
+        }
+    }
+
+    /// Whether a batch before `gvt` cancelled `uid` (for good).
+    fn committed(&self, uid: u64, gvt: f64) -> bool {
+        self.cancels
+            .get(&uid)
+            .is_some_and(|c| c.by.iter().any(|&(at, n)| n > 0 && at < gvt))
+    }
+
+    /// Fossil collection: frees cancelled messages that nothing can revive any more (before
+    /// GVT, or cancelled by a committed batch) and the marks of messages before GVT (every
+    /// message before it has left the heap, and none is on its way).
+    pub fn collect(&mut self, gvt: f64) {
+        let cancels = &mut self.cancels;
+        self.dead.retain(|uid, p| {
+            let committed = cancels
+                .get(uid)
+                .is_some_and(|c| c.by.iter().any(|&(at, n)| n > 0 && at < gvt));
+            let gone = p.time.t() < gvt || committed;
+            if gone {
+                cancels.remove(uid);
+            }
+            !gone
+        });
+        cancels.retain(|_, c| c.t >= gvt);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::{Envelope, VTime};
+    use crate::vtime::Key;
+
+    fn msg(t: f64) -> Pending<u8> {
+        Pending {
+            time: VTime::at(Key::start(t)),
+            to: 0,
+            priority: 0,
+            retractable: true,
+            env: Envelope {
+                from: 1,
+                seq: 1,
+                msg: 0,
+            },
+        }
+    }
+
+    #[test]
+    fn an_anti_message_meets_its_message_in_either_order() {
+        let mut m: Marks<u8> = Marks::default();
+        assert_eq!(m.of(7, true), Mark::Live);
+        // the anti-message first: the message is dropped as it arrives
+        assert!(!m.annul(7));
+        assert_eq!(m.of(7, false), Mark::Annulled);
+        assert!(!m.arrives(7));
+        assert_eq!(m.of(7, true), Mark::Live);
+        // the message first, in the heap: it is dropped when it reaches the top
+        assert!(m.arrives(8));
+        m.annul(8);
+        m.set_aside(8, msg(1.0), Mark::Annulled);
+        assert_eq!(m.pending_marks(), 0);
+    }
+
+    #[test]
+    fn a_cancellation_undone_brings_its_message_back() {
+        let mut m: Marks<u8> = Marks::default();
+        assert!(m.cancel(3, 2.0, 1.0, 1).is_none());
+        assert_eq!(m.of(3, true), Mark::Cancelled);
+        assert_eq!(m.of(3, false), Mark::Live, "a relay is never cancelled");
+        m.set_aside(3, msg(2.0), Mark::Cancelled);
+        assert_eq!(m.set_aside_len(), 1);
+        let back = m
+            .cancel(3, 2.0, 1.0, -1)
+            .expect("set aside, and live again");
+        assert_eq!(back.time.t(), 2.0);
+        assert_eq!((m.of(3, true), m.set_aside_len()), (Mark::Live, 0));
+        // an undoing that arrives before its cancellation cancels until they meet
+        assert!(m.cancel(4, 2.0, 1.0, -1).is_none());
+        assert_eq!(m.of(4, true), Mark::Cancelled);
+        assert!(m.cancel(4, 2.0, 1.0, 1).is_none());
+        assert_eq!(m.of(4, true), Mark::Live);
+    }
+
+    #[test]
+    fn fossil_collection_frees_what_nothing_can_revive() {
+        let mut m: Marks<u8> = Marks::default();
+        m.cancel(1, 5.0, 1.0, 1);
+        m.set_aside(1, msg(5.0), Mark::Cancelled);
+        m.cancel(2, 5.0, 3.0, 1);
+        m.set_aside(2, msg(5.0), Mark::Cancelled);
+        // GVT 2: message 1's cancellation is committed, message 2's may still be undone
+        m.collect(2.0);
+        assert_eq!(m.set_aside_len(), 1);
+        assert_eq!(m.of(2, true), Mark::Cancelled);
+        // a cancelled message still in the heap stays until its cancellation is committed
+        m.cancel(9, 5.0, 3.0, 1);
+        assert!(
+            m.keeps(9, true, 2.0),
+            "its cancellation may still be undone"
+        );
+        assert!(!m.keeps(9, true, 4.0));
+        assert_eq!(m.of(9, true), Mark::Live, "dropped, and unmarked");
+        // past the messages' time, nothing is left
+        m.collect(6.0);
+        assert_eq!((m.set_aside_len(), m.pending_marks()), (0, 0));
+    }
+}
