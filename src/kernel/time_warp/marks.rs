@@ -35,6 +35,9 @@ pub struct Marks<Msg> {
     cancels: FxHashMap<u64, Cancels>,
     /// Cancelled messages taken off the heap, by uid: undoing the cancellation brings them back.
     dead: FxHashMap<u64, Pending<Msg>>,
+    /// Size of `cancels` and `dead` past which fossil collection sweeps them (amortized: twice
+    /// what is left after each sweep).
+    sweep_at: usize,
 }
 
 impl<Msg> Default for Marks<Msg> {
@@ -43,6 +46,7 @@ impl<Msg> Default for Marks<Msg> {
             annulled: FxHashSet::default(),
             cancels: FxHashMap::default(),
             dead: FxHashMap::default(),
+            sweep_at: 1024,
         }
     }
 }
@@ -159,8 +163,11 @@ impl<Msg> Marks<Msg> {
 
     /// Fossil collection: frees cancelled messages that nothing can revive any more (before
     /// GVT, or cancelled by a committed batch) and the marks of messages before GVT (every
-    /// message before it has left the heap, and none is on its way).
+    /// message before it has left the heap, and none is on its way), once they are many.
     pub fn collect(&mut self, gvt: f64) {
+        if self.cancels.len() + self.dead.len() <= self.sweep_at {
+            return;
+        }
         let cancels = &mut self.cancels;
         self.dead.retain(|uid, p| {
             let committed = cancels
@@ -173,6 +180,7 @@ impl<Msg> Marks<Msg> {
             !gone
         });
         cancels.retain(|_, c| c.t >= gvt);
+        self.sweep_at = (2 * (self.cancels.len() + self.dead.len())).max(1024);
     }
 }
 
@@ -234,7 +242,10 @@ mod tests {
 
     #[test]
     fn fossil_collection_frees_what_nothing_can_revive() {
-        let mut m: Marks<u8> = Marks::default();
+        let mut m: Marks<u8> = Marks {
+            sweep_at: 0,
+            ..Marks::default()
+        };
         m.cancel(1, 5.0, 1.0, 1);
         m.set_aside(1, msg(5.0), Mark::Cancelled);
         m.cancel(2, 5.0, 3.0, 1);
@@ -252,6 +263,7 @@ mod tests {
         assert!(!m.keeps(9, true, 4.0));
         assert_eq!(m.of(9, true), Mark::Live, "dropped, and unmarked");
         // past the messages' time, nothing is left
+        m.sweep_at = 0;
         m.collect(6.0);
         assert_eq!((m.set_aside_len(), m.pending_marks()), (0, 0));
     }
