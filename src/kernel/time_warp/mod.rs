@@ -355,6 +355,46 @@ struct Input {
     retractable: bool,
 }
 
+/// Vectors of finished batches, kept for the next ones: a worker runs millions of batches, and
+/// each would otherwise allocate and free the same few small vectors.
+struct Spare<Msg> {
+    inputs: Vec<Vec<Input>>,
+    batches: Vec<Vec<Envelope<Msg>>>,
+    sent: Vec<Vec<(Sent, u16)>>,
+    /// What the model's handler sends, emptied after every batch.
+    pending: Vec<Pending<Msg>>,
+    /// Ops a batch makes, emptied after every batch.
+    ops: Vec<Op<Msg>>,
+}
+
+/// Vectors of each kind kept at most.
+const SPARE: usize = 64;
+
+impl<Msg> Default for Spare<Msg> {
+    fn default() -> Self {
+        Spare {
+            inputs: Vec::new(),
+            batches: Vec::new(),
+            sent: Vec::new(),
+            pending: Vec::new(),
+            ops: Vec::new(),
+        }
+    }
+}
+
+/// A spare vector, or a new one.
+fn take<T>(pool: &mut Vec<Vec<T>>) -> Vec<T> {
+    pool.pop().unwrap_or_default()
+}
+
+/// Keeps `v`, emptied, for another batch.
+fn give<T>(pool: &mut Vec<Vec<T>>, mut v: Vec<T>) {
+    if pool.len() < SPARE && v.capacity() > 0 {
+        v.clear();
+        pool.push(v);
+    }
+}
+
 /// A batch an object ran that is not committed yet.
 struct Done<M: Model> {
     time: VTime,
@@ -479,6 +519,8 @@ pub struct Worker<M: Model> {
     current: Key,
     /// Ops for this worker's objects.
     local_ops: Vec<Op<M::Msg>>,
+    /// Vectors for the next batches.
+    spare: Spare<M::Msg>,
     outbox: Vec<Vec<Op<M::Msg>>>,
     /// Chaos mode: its random stream and the ops it holds back.
     chaos: Option<Chaos<M::Msg>>,
@@ -556,6 +598,7 @@ impl<M: Model> Worker<M> {
             marks: Marks::default(),
             current: Key::start(f64::NEG_INFINITY),
             local_ops: Vec::new(),
+            spare: Spare::default(),
             outbox: (0..workers).map(|_| Vec::new()).collect(),
             chaos: chaos.map(|s| Chaos {
                 rng: ChaCha8Rng::seed_from_u64(s ^ (index as u64).wrapping_mul(0x9e37_79b9)),
@@ -757,7 +800,8 @@ impl<M: Model> Worker<M> {
             lp.state = d.pre_state.expect("an uncommitted batch saved its state");
             lp.seq = d.pre_seq;
             let to = lp.id;
-            for (i, env) in d.inputs.into_iter().zip(d.batch) {
+            let (mut inputs, mut batch, mut sent) = (d.inputs, d.batch, d.sent);
+            for (i, env) in inputs.drain(..).zip(batch.drain(..)) {
                 let p = Pending {
                     time: d.time.clone(),
                     to,
@@ -767,7 +811,7 @@ impl<M: Model> Worker<M> {
                 };
                 self.heap.push(Item { uid: i.uid, p }, false);
             }
-            for (s, _) in d.sent {
+            for (s, _) in sent.drain(..) {
                 let op = Op::Anti {
                     uid: s.uid,
                     to: s.to,
@@ -775,6 +819,9 @@ impl<M: Model> Worker<M> {
                 };
                 self.route(op);
             }
+            give(&mut self.spare.inputs, inputs);
+            give(&mut self.spare.batches, batch);
+            give(&mut self.spare.sent, sent);
             for c in d.cancels {
                 let op = Op::Cancel {
                     uid: c.uid,
@@ -841,12 +888,14 @@ impl<M: Model> Worker<M> {
         if self.current != time.key {
             self.current = time.key.clone();
         }
-        let mut inputs = vec![Input {
+        let mut inputs = take(&mut self.spare.inputs);
+        let mut batch = take(&mut self.spare.batches);
+        inputs.push(Input {
             uid: first.uid,
             priority: first.p.priority,
             retractable: first.p.retractable,
-        }];
-        let mut batch = vec![first.p.env];
+        });
+        batch.push(first.p.env);
         while let Some(top) = self.heap.peek() {
             if top.p.time != time || top.p.to != to {
                 break;
@@ -893,12 +942,13 @@ impl<M: Model> Worker<M> {
         let pre_state = (!run_final).then(|| lp.state.clone());
         let pre_seq = lp.seq;
         let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq);
+        ctx.sent = std::mem::take(&mut self.spare.pending);
         model.handle(&mut ctx, to, &mut lp.state, &batch);
-        let (sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
+        let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
         let into_past = ctx.into_past;
-        let mut ops = Vec::with_capacity(sent.len());
-        let mut sent_recs = Vec::with_capacity(sent.len());
-        for p in sent {
+        let mut ops = std::mem::take(&mut self.spare.ops);
+        let mut sent_recs = take(&mut self.spare.sent);
+        for p in sent.drain(..) {
             let uid = lp.next_uid();
             let s = Sent {
                 uid,
@@ -910,6 +960,7 @@ impl<M: Model> Worker<M> {
             sent_recs.push((s, model.kind(&p.env.msg) as u16));
             ops.push(Op::Msg { uid, p });
         }
+        self.spare.pending = sent;
         let mut cancels = Vec::new();
         for h in &cancelled {
             let this_batch = sent_recs.binary_search_by_key(&h.seq, |(s, _)| s.seq);
@@ -962,9 +1013,10 @@ impl<M: Model> Worker<M> {
             self.uncommitted += 1;
             self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
         }
-        for op in ops {
+        for op in ops.drain(..) {
             self.route(op);
         }
+        self.spare.ops = ops;
         self.drain_local();
         true
     }
@@ -1084,7 +1136,7 @@ impl<M: Model> Worker<M> {
     /// Commits one batch of local object `li`: counts it, files the sends a later batch may
     /// still cancel (those `floor` has not passed), frees its input records, and keeps for the
     /// collector what its sinks see (`state` is the object's state after it, when observed).
-    fn commit(&mut self, li: usize, d: Done<M>, state: Option<M::State>, floor: &Floor) {
+    fn commit(&mut self, li: usize, mut d: Done<M>, state: Option<M::State>, floor: &Floor) {
         if let Some(what) = d.into_past {
             self.fault
                 .get_or_insert(format!("model bug in a committed batch: {what}"));
@@ -1095,7 +1147,7 @@ impl<M: Model> Worker<M> {
         cs.batches += 1;
         cs.delivered += d.batch.len() as u64;
         cs.cancels += u64::from(d.cancel_calls);
-        for (s, kind) in d.sent {
+        for (s, kind) in d.sent.drain(..) {
             cs.count(usize::from(kind));
             // still ahead: it may yet be cancelled by a later batch
             if s.retractable && !floor.passed(&s.time, s.to) {
@@ -1106,11 +1158,15 @@ impl<M: Model> Worker<M> {
         for c in &d.cancels {
             lp.sends.remove(&c.seq);
         }
+        let id = lp.id;
+        give(&mut self.spare.sent, d.sent);
+        give(&mut self.spare.inputs, d.inputs);
+        give(&mut self.spare.batches, d.batch);
         // the collector needs only what its sinks see
         if state.is_some() || !d.output.is_empty() {
             self.to_ship.push(Committed {
                 time: d.time,
-                obj: lp.id,
+                obj: id,
                 state,
                 output: d.output,
             });
