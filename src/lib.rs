@@ -10,7 +10,8 @@
 //! - [`model`]: the pool objects and PHOLD as kernel models;
 //! - [`engine`]: the event-list, time-step and objects engines;
 //! - [`check`]: invariants checked while a run goes (`--check`);
-//! - [`output`]: the trace, final state and run summary.
+//! - [`output`]: the trace, final state and run summary;
+//! - [`memory`]: the one memory setting that depends on the engine (huge pages).
 
 pub mod analytic;
 pub mod bench;
@@ -19,6 +20,7 @@ pub mod engine;
 pub mod experiment;
 pub mod geometry;
 pub mod kernel;
+pub mod memory;
 pub mod model;
 pub mod output;
 pub mod physics;

@@ -369,6 +369,9 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
             )))
         }
     };
+    if tw.is_some() {
+        poolsim::memory::transparent_huge_pages(false);
+    }
     #[cfg(feature = "mpi")]
     let _mpi = if tw.is_some() { start_mpi()? } else { None };
     let partitions = a.partitions.unwrap_or_else(|| match &tw {
@@ -782,6 +785,9 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         EngineKind::Objects { .. } | EngineKind::Sectored { .. } | EngineKind::TimeWarp { .. }
     );
     let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
+    if time_warp {
+        poolsim::memory::transparent_huge_pages(false);
+    }
     let sectored = matches!(
         engine,
         EngineKind::Sectored { .. }
