@@ -562,7 +562,7 @@ pub struct TwRow {
 /// Runs the sectored gas (`--sectors auto`) of `balls` balls until `until` on the sequential
 /// objects engine and under Time Warp on 1 and 2 workers (`pure`: no batch run as final);
 /// fails if any digest differs. All of them run without transparent huge pages, as
-/// `poolsim run` runs Time Warp ([`crate::memory`]).
+/// `poolsim run` runs the objects engines ([`crate::memory`]).
 pub fn measure_time_warp(balls: usize, until: f64, pure: bool) -> Result<Vec<TwRow>, String> {
     crate::memory::transparent_huge_pages(false);
     let rows = time_warp_rows(balls, until, pure);

@@ -785,7 +785,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
         EngineKind::Objects { .. } | EngineKind::Sectored { .. } | EngineKind::TimeWarp { .. }
     );
     let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
-    if time_warp {
+    if objects {
         poolsim::memory::transparent_huge_pages(false);
     }
     let sectored = matches!(
