@@ -1057,7 +1057,8 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
 }
 
 /// The main job: the thesis' sectored 36-ball gas (plates 9-13: 2 x 2 sectors, frames every 0.1
-/// up to 4) on the objects engine, checked at every event, drawn as one page with a player.
+/// up to 4) on the objects engine with the thesis' message flow, checked at every event, drawn
+/// as one page with a player.
 fn demo(json: bool, out: &std::path::Path) -> Result<(), Failure> {
     let scenario = load("gas", &GenArgs::default())?;
     let sectors = SectorChoice::Grid(2, 2);
@@ -1067,7 +1068,7 @@ fn demo(json: bool, out: &std::path::Path) -> Result<(), Failure> {
         ..poolsim::render::RenderConfig::new(
             EngineKind::Sectored {
                 sectors,
-                news: FixedNews::default(),
+                news: FixedNews::Thesis,
             },
             scenario.until,
             0.1,
