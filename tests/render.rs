@@ -11,6 +11,13 @@ use poolsim::scenario::{self, builtin::Params, Scenario};
 use std::path::Path;
 use std::process::Command;
 
+/// The sectored objects engine on `grid`.
+fn sectored(grid: SectorChoice) -> EngineKind {
+    EngineKind::Sectored {
+        sectors: grid,
+        news: poolsim::run::FixedNews::Near,
+    }
+}
 fn scenario(spec: &str) -> Scenario {
     scenario::load(spec, &Params::default()).expect("the scenario loads")
 }
@@ -200,10 +207,7 @@ fn every_engine_draws_the_same_picture() {
     let mut cfg = config(EngineKind::EventList, 1.0, 0.25);
     cfg.sectors = Some(grid);
     let a = record(&gas, &cfg).expect("event-list records");
-    cfg.engine = EngineKind::Sectored {
-        sectors: grid,
-        news: poolsim::run::FixedNews::Near,
-    };
+    cfg.engine = sectored(grid);
     let b = record(&gas, &cfg).expect("sectored records");
     assert_eq!(a.shots.len(), 5);
     for k in 0..a.shots.len() {
@@ -227,18 +231,7 @@ fn the_history_gives_the_engines_frames_and_the_messages_add_up() {
         }
     }
     let grid = SectorChoice::Grid(2, 2);
-    let rec = record(
-        &scenario("gas"),
-        &config(
-            EngineKind::Sectored {
-                sectors: grid,
-                news: poolsim::run::FixedNews::Near,
-            },
-            2.0,
-            0.5,
-        ),
-    )
-    .expect("records");
+    let rec = record(&scenario("gas"), &config(sectored(grid), 2.0, 0.5)).expect("records");
     let h = rec.history.as_ref().expect("history");
     for shot in &rec.shots {
         assert_eq!(h.frame_at(shot.frame.t), shot.frame, "t = {}", shot.frame.t);
@@ -263,14 +256,7 @@ fn the_history_gives_the_engines_frames_and_the_messages_add_up() {
 #[test]
 fn the_page_is_one_file_with_its_data_and_no_network() {
     let grid = SectorChoice::Grid(2, 2);
-    let mut cfg = config(
-        EngineKind::Sectored {
-            sectors: grid,
-            news: poolsim::run::FixedNews::Near,
-        },
-        4.0,
-        0.1,
-    );
+    let mut cfg = config(sectored(grid), 4.0, 0.1);
     cfg.sectors = Some(grid);
     let rec = record(&scenario("gas"), &cfg).expect("records");
     let page = html::page(&rec);
@@ -502,14 +488,7 @@ fn the_page_in_a_browser_shows_the_trace_s_positions() {
     };
     let dir = tempfile::tempdir().expect("a temporary folder");
     let grid = SectorChoice::Grid(2, 2);
-    let mut cfg = config(
-        EngineKind::Sectored {
-            sectors: grid,
-            news: poolsim::run::FixedNews::Near,
-        },
-        4.0,
-        0.1,
-    );
+    let mut cfg = config(sectored(grid), 4.0, 0.1);
     cfg.sectors = Some(grid);
     // Without its history the page moves balls linearly between frames: exact for plate 1
     // between 1.0 and 1.5, before the collision at 1.6.
