@@ -125,6 +125,37 @@ fn sectored_gas_is_exact_and_rolls_back() {
     }
 }
 
+/// With the thesis' flow (every ball tells every cushion), too: the same trace and messages as
+/// the sequential run with that flow, on 2 workers with chaos.
+#[test]
+fn the_thesis_flow_of_news_is_exact_too() {
+    let s = gas(64, 3);
+    let sectors = SectorChoice::Grid(4, 4);
+    let want = run(
+        &s,
+        EngineKind::Sectored {
+            sectors,
+            news: FixedNews::Thesis,
+        },
+    );
+    let mut engine = pure_or_not(Some(sectors), 2, Some(7), false);
+    if let EngineKind::TimeWarp { news, .. } = &mut engine {
+        *news = FixedNews::Thesis;
+    }
+    let got = run(&s, engine);
+    assert_eq!(got.trace, want.trace);
+    for field in ["final_state_digest", "messages"] {
+        assert_eq!(got.summary[field], want.summary[field], "{field}");
+    }
+    let near = run(&s, sequential(Some(sectors)));
+    assert_eq!(near.trace, want.trace);
+    assert!(
+        near.summary["messages"]["NewVelocity"].as_u64()
+            < want.summary["messages"]["NewVelocity"].as_u64(),
+        "cushions in reach hear less than every cushion"
+    );
+}
+
 #[test]
 fn plain_gas_is_exact() {
     assert_same(&gas(16, 5), None);
