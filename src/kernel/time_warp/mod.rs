@@ -207,6 +207,16 @@ pub enum Op<Msg> {
         /// is final.
         at: f64,
     },
+    /// A model cancellation of `uid` by a batch that ran as final: it can never be undone, so
+    /// the message is gone for good, as an anti-message makes it.
+    Retract {
+        /// The cancelled message.
+        uid: u64,
+        /// Its receiver.
+        to: u32,
+        /// Its time.
+        time: VTime,
+    },
 }
 
 impl<Msg> Op<Msg> {
@@ -214,7 +224,7 @@ impl<Msg> Op<Msg> {
     pub fn to(&self) -> u32 {
         match self {
             Op::Msg { p, .. } => p.to,
-            Op::Anti { to, .. } | Op::Cancel { to, .. } => *to,
+            Op::Anti { to, .. } | Op::Cancel { to, .. } | Op::Retract { to, .. } => *to,
         }
     }
 
@@ -222,7 +232,7 @@ impl<Msg> Op<Msg> {
     pub fn time(&self) -> &VTime {
         match self {
             Op::Msg { p, .. } => &p.time,
-            Op::Anti { time, .. } | Op::Cancel { time, .. } => time,
+            Op::Anti { time, .. } | Op::Cancel { time, .. } | Op::Retract { time, .. } => time,
         }
     }
 }
@@ -705,7 +715,7 @@ impl<M: Model> Worker<M> {
                 }
             }
             Op::Anti { .. } => self.stats.anti_messages += 1,
-            Op::Cancel { .. } => {}
+            Op::Cancel { .. } | Op::Retract { .. } => {}
         }
         if w == self.index {
             self.local_ops.push(op);
@@ -748,7 +758,7 @@ impl<M: Model> Worker<M> {
                 }
                 self.push(Item { uid, p });
             }
-            Op::Anti { uid, time, .. } => {
+            Op::Anti { uid, time, .. } | Op::Retract { uid, time, .. } => {
                 // a cancelled message was handled by no batch that stands
                 let unseen = self.marks.cancelled(uid);
                 if self.marks.annul(uid) || unseen {
@@ -976,14 +986,18 @@ impl<M: Model> Worker<M> {
             }
         }
         for c in &cancels {
-            let op = Op::Cancel {
-                uid: c.uid,
-                to: c.to,
-                time: c.time.clone(),
-                sign: 1,
-                at: time.t(),
-            };
-            ops.push(op);
+            let (uid, to, t) = (c.uid, c.to, c.time.clone());
+            ops.push(if run_final {
+                Op::Retract { uid, to, time: t }
+            } else {
+                Op::Cancel {
+                    uid,
+                    to,
+                    time: t,
+                    sign: 1,
+                    at: time.t(),
+                }
+            });
         }
         let done = Done {
             time,
