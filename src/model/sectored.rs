@@ -38,6 +38,7 @@ use crate::physics::{self, Contact};
 use crate::polygon::{self, Polygon};
 use crate::scenario::Scenario;
 use crate::vtime::{pair, Key, DEPARTURE, REVERSAL};
+use smallvec::SmallVec;
 use std::sync::Arc;
 
 /// The sectors of a table: their polygons, which touch which, and a bucket index of their boxes
@@ -178,11 +179,12 @@ impl Layout {
 }
 
 /// For each sector, the fixed objects a ball touching it may reach before it leaves the sectors
-/// near them, and the fixed objects no sector is near (all of them with [`FixedNews::Thesis`]). A ball whose disk touches a fixed object
-/// at time t has its centre in some sector within its radius of the contact point, and was in
-/// sectors within twice its radius for a time r / v before: so a fixed object within
-/// `2 rmax` of a sector (plus rounding) hears of every trajectory that can reach it, from the
-/// ball when it changes course in such a sector or enters one.
+/// near them, and the fixed objects no sector is near (all of them with [`FixedNews::Thesis`]).
+/// A ball whose disk touches a fixed object at time t has its centre in some sector within its
+/// radius of the contact point, and was in sectors within twice its radius for a time r / v
+/// before: so a fixed object within `2 rmax` of a sector (plus rounding) hears of every
+/// trajectory that can reach it, from the ball when it changes course in such a sector or
+/// enters one.
 fn near_fixed(table: &Table, layout: &Layout, rmax: f64) -> (Vec<Vec<u32>>, Vec<u32>) {
     let size = (table.hi - table.lo).norm();
     let reach = 2.0 * rmax + 1e-9 * size;
@@ -418,9 +420,9 @@ impl Sectored {
     }
 
     /// The fixed objects a ball in `sectors` could reach before it leaves them, in order.
-    fn fixed_near(&self, sectors: &[u32]) -> Vec<u32> {
+    fn fixed_near(&self, sectors: &[u32]) -> SmallVec<[u32; 8]> {
         let first = self.first_sector();
-        let mut fs = self.far_fixed.clone();
+        let mut fs = SmallVec::from_slice(&self.far_fixed);
         for &s in sectors {
             fs.extend_from_slice(&self.near_fixed[(s - first) as usize]);
         }
