@@ -16,6 +16,13 @@ struct Cancels {
     by: SmallVec<[(f64, i32); 1]>,
 }
 
+impl Cancels {
+    /// Whether a batch before `gvt` cancelled the message (committed: for good).
+    fn committed(&self, gvt: f64) -> bool {
+        self.by.iter().any(|&(at, n)| n > 0 && at < gvt)
+    }
+}
+
 /// How a message stands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mark {
@@ -144,7 +151,7 @@ impl<Msg> Marks<Msg> {
                 false
             }
             Mark::Cancelled => {
-                if self.committed(uid, gvt) {
+                if self.cancels.get(&uid).is_some_and(|c| c.committed(gvt)) {
                     self.cancels.remove(&uid);
                     false
                 } else {
@@ -152,13 +159,6 @@ impl<Msg> Marks<Msg> {
                 }
             }
         }
-    }
-
-    /// Whether a batch before `gvt` cancelled `uid` (for good).
-    fn committed(&self, uid: u64, gvt: f64) -> bool {
-        self.cancels
-            .get(&uid)
-            .is_some_and(|c| c.by.iter().any(|&(at, n)| n > 0 && at < gvt))
     }
 
     /// Fossil collection: frees cancelled messages that nothing can revive any more (before
@@ -170,10 +170,7 @@ impl<Msg> Marks<Msg> {
         }
         let cancels = &mut self.cancels;
         self.dead.retain(|uid, p| {
-            let committed = cancels
-                .get(uid)
-                .is_some_and(|c| c.by.iter().any(|&(at, n)| n > 0 && at < gvt));
-            let gone = p.time.t() < gvt || committed;
+            let gone = p.time.t() < gvt || cancels.get(uid).is_some_and(|c| c.committed(gvt));
             if gone {
                 cancels.remove(uid);
             }

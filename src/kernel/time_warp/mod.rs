@@ -325,6 +325,30 @@ impl<Msg> Item<Msg> {
     fn order(&self, o: &Self) -> Ordering {
         self.p.order(&o.p).then(self.uid.cmp(&o.uid))
     }
+
+    /// What a batch keeps of it: its name, and the envelope the model reads.
+    fn into_input(self) -> (Input, Envelope<Msg>) {
+        let input = Input {
+            uid: self.uid,
+            priority: self.p.priority,
+            retractable: self.p.retractable,
+        };
+        (input, self.p.env)
+    }
+}
+
+impl Input {
+    /// The message again, as it waited for the batch of `to` at `time` (undone by a rollback).
+    fn into_item<Msg>(self, env: Envelope<Msg>, time: &VTime, to: u32) -> Item<Msg> {
+        let p = Pending {
+            time: time.clone(),
+            to,
+            priority: self.priority,
+            retractable: self.retractable,
+            env,
+        };
+        Item { uid: self.uid, p }
+    }
 }
 
 impl<Msg> PartialEq for Item<Msg> {
@@ -812,14 +836,7 @@ impl<M: Model> Worker<M> {
             let to = lp.id;
             let (mut inputs, mut batch, mut sent) = (d.inputs, d.batch, d.sent);
             for (i, env) in inputs.drain(..).zip(batch.drain(..)) {
-                let p = Pending {
-                    time: d.time.clone(),
-                    to,
-                    priority: i.priority,
-                    retractable: i.retractable,
-                    env,
-                };
-                self.heap.push(Item { uid: i.uid, p }, false);
+                self.heap.push(i.into_item(env, &d.time, to), false);
             }
             for (s, _) in sent.drain(..) {
                 let op = Op::Anti {
@@ -900,12 +917,9 @@ impl<M: Model> Worker<M> {
         }
         let mut inputs = take(&mut self.spare.inputs);
         let mut batch = take(&mut self.spare.batches);
-        inputs.push(Input {
-            uid: first.uid,
-            priority: first.p.priority,
-            retractable: first.p.retractable,
-        });
-        batch.push(first.p.env);
+        let (input, env) = first.into_input();
+        inputs.push(input);
+        batch.push(env);
         while let Some(top) = self.heap.peek() {
             if top.p.time != time || top.p.to != to {
                 break;
@@ -913,12 +927,9 @@ impl<M: Model> Worker<M> {
             let it = self.heap.pop().expect("a top");
             match self.marks.of(it.uid, it.p.retractable) {
                 Mark::Live => {
-                    inputs.push(Input {
-                        uid: it.uid,
-                        priority: it.p.priority,
-                        retractable: it.p.retractable,
-                    });
-                    batch.push(it.p.env);
+                    let (input, env) = it.into_input();
+                    inputs.push(input);
+                    batch.push(env);
                 }
                 mark => self.marks.set_aside(it.uid, it.p, mark),
             }
@@ -986,6 +997,7 @@ impl<M: Model> Worker<M> {
             }
         }
         for c in &cancels {
+            // the cancelled message's receiver and time, not this batch's
             let (uid, to, t) = (c.uid, c.to, c.time.clone());
             ops.push(if run_final {
                 Op::Retract { uid, to, time: t }
