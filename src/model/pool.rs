@@ -51,11 +51,22 @@ pub struct BallInfo {
     pub mass: f64,
     /// The key of the event that fixed the trajectory.
     pub fixed: Key,
+    /// How many times `fixed` has changed: it orders one ball's trajectories as `fixed` does,
+    /// in a word that a sector's state or a message can copy for nothing.
+    pub version: u32,
     /// The pocket it dropped into.
     pub pocket: Option<u32>,
 }
 
 impl BallInfo {
+    /// The trajectory is fixed at `key` now (a new version, unless it was fixed there already).
+    pub fn fix(&mut self, key: &Key) {
+        if self.fixed != *key {
+            self.fixed = key.clone();
+            self.version += 1;
+        }
+    }
+
     /// Turns ball `me` around at `now` (thesis 4.6, fig. 13). On the table it takes a position fix
     /// and reverses: `None`, its trajectory changed now. In a pocket it reverses the crossing it
     /// dropped in by and returns the key at which it comes back out (the mirror image in time).
@@ -64,7 +75,7 @@ impl BallInfo {
             None => {
                 self.traj.position = self.traj.at(now.t());
                 self.traj.t0 = now.t();
-                self.fixed = now.key.clone();
+                self.fix(&now.key);
                 None
             }
             Some(k) => {
@@ -82,7 +93,7 @@ impl BallInfo {
     /// crossing).
     pub fn come_back(&mut self, me: u32, now: &VTime, table: &Table) -> Event {
         let k = self.pocket.take().expect("only a pocketed ball returns");
-        self.fixed = now.key.clone();
+        self.fix(&now.key);
         Event {
             t: now.t(),
             kind: EventKind::BallPocket,
@@ -261,6 +272,7 @@ impl Pool {
                     radius: b.radius,
                     mass: b.mass,
                     fixed: Key::start(span.start),
+                    version: 0,
                     pocket: None,
                 }),
                 planned: Vec::new(),
@@ -438,7 +450,7 @@ impl Pool {
                     }
                     me_info.traj.position = p;
                     me_info.traj.t0 = t;
-                    me_info.fixed = now.key.clone();
+                    me_info.fix(&now.key);
                     changed = true;
                     if let Some((kind, a, b)) = kind {
                         ctx.emit(PoolOutput::Event(Event { t, kind, a, b }));

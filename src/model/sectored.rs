@@ -234,7 +234,7 @@ pub enum SecMsg {
         /// The partner ball's trajectory as the scheduler knew it.
         info: Option<Arc<BallInfo>>,
         /// The receiver's trajectory version as the scheduler knew it.
-        seen: Key,
+        seen: u32,
     },
     /// Turn around now (thesis 4.6), sent by each ball to itself at the start.
     ReverseYourself,
@@ -267,6 +267,10 @@ pub enum SecMsg {
         ball: u32,
         /// The sector.
         sector: u32,
+        /// In the sector's own copy, the ball's trajectory the entry was computed from (relayed
+        /// to the sector's balls when the ball enters): the message keeps it, so that the
+        /// sector's state holds no shared pointers to copy when it is saved.
+        info: Option<Arc<BallInfo>>,
     },
     /// A ball's disk stops touching a sector.
     SectorDeparture {
@@ -294,9 +298,9 @@ const KIND_NAMES: [&str; 9] = [
 pub struct Passage {
     /// The ball.
     pub ball: u32,
-    /// For an entry, the ball's trajectory it was computed from (relayed to the sector's balls
-    /// when the ball enters); `None` for a departure.
-    pub entry: Option<Arc<BallInfo>>,
+    /// For an entry, the version of the ball's trajectory it was computed from; `None` for a
+    /// departure.
+    pub entry: Option<u32>,
     /// The message to the sector itself.
     pub own: Handle,
     /// The message to the ball.
@@ -324,10 +328,10 @@ pub enum SecState {
     },
     /// A sector.
     Sector {
-        /// Balls whose disks touch it, with the version (fixing key) of their trajectories as
-        /// last heard: a key, not the trajectory, so that saving the state copies no shared
-        /// pointers.
-        members: Vec<(u32, Key)>,
+        /// Balls whose disks touch it, with the version ([`BallInfo::version`]) of their
+        /// trajectories as last heard: a word, not the trajectory or its key, so that saving the
+        /// state is one plain copy.
+        members: Vec<(u32, u32)>,
         /// Entries and departures it scheduled.
         planned: Vec<Passage>,
     },
@@ -351,7 +355,7 @@ impl Sectored {
         let table = Table::new(s);
         let n = table.n_balls;
         let first_sector = n + table.n_fixed();
-        let mut members: Vec<Vec<(u32, Key)>> = vec![Vec::new(); layout.polys.len()];
+        let mut members: Vec<Vec<(u32, u32)>> = vec![Vec::new(); layout.polys.len()];
         let mut states: Vec<SecState> = Vec::new();
         for (i, b) in s.balls.iter().enumerate() {
             let info = Arc::new(BallInfo {
@@ -363,13 +367,14 @@ impl Sectored {
                 radius: b.radius,
                 mass: b.mass,
                 fixed: Key::start(span.start),
+                version: 0,
                 pocket: None,
             });
             let sectors: Vec<u32> = layout
                 .touching(b.position, b.radius)
                 .into_iter()
                 .map(|k| {
-                    members[k as usize].push((i as u32, info.fixed.clone()));
+                    members[k as usize].push((i as u32, info.version));
                     first_sector + k
                 })
                 .collect();
@@ -463,9 +468,9 @@ impl Sectored {
         partner: u32,
         key: Key,
         mine: Option<Arc<BallInfo>>,
-        my_version: Key,
+        my_version: u32,
         theirs: Option<Arc<BallInfo>>,
-        their_version: Key,
+        their_version: u32,
     ) -> Planned {
         let time = VTime::at(key);
         let own = ctx.send_at(
@@ -533,7 +538,7 @@ impl Sectored {
                     if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
                         planned.swap_remove(k);
                     }
-                    let valid = info.fixed == *seen && info.pocket.is_none();
+                    let valid = info.version == *seen && info.pocket.is_none();
                     if other.is_some() {
                         ctx.send_now(
                             *partner,
@@ -589,9 +594,9 @@ impl Sectored {
                             *ball,
                             key,
                             Some(info.clone()),
-                            info.fixed.clone(),
+                            info.version,
                             Some(x.clone()),
-                            x.fixed.clone(),
+                            x.version,
                         );
                         planned.push(p);
                     }
@@ -694,7 +699,7 @@ impl Sectored {
             velocity: v,
             t0: t,
         };
-        me_info.fixed = now.key.clone();
+        me_info.fix(&now.key);
         if me > partner {
             ctx.emit(Event {
                 t,
@@ -722,7 +727,7 @@ impl Sectored {
         }
         me_info.traj.position = p;
         me_info.traj.t0 = t;
-        me_info.fixed = now.key.clone();
+        me_info.fix(&now.key);
         ctx.emit(Event {
             t,
             kind: self.table.event_kind(f),
@@ -748,9 +753,8 @@ impl Sectored {
                     }
                     let contact = self.table.contact(me, &x.traj, x.radius);
                     if let Some(key) = Self::key_of(contact, &x.fixed, pair(*ball, me)) {
-                        let none = Key::start(f64::NEG_INFINITY);
-                        let p =
-                            Self::schedule(ctx, me, *ball, key, None, none, None, x.fixed.clone());
+                        // a fixed object's own message carries no version: it never changes
+                        let p = Self::schedule(ctx, me, *ball, key, None, 0, None, x.version);
                         planned.add(p);
                     }
                 }
@@ -768,16 +772,26 @@ impl Sectored {
         entry: Option<Arc<BallInfo>>,
         time: VTime,
     ) -> Passage {
-        let msg = if entry.is_some() {
-            SecMsg::SectorEntry { ball, sector: me }
-        } else {
-            SecMsg::SectorDeparture { ball, sector: me }
+        let version = entry.as_ref().map(|e| e.version);
+        let (own, other) = match entry {
+            Some(info) => {
+                let entering = |info| SecMsg::SectorEntry {
+                    ball,
+                    sector: me,
+                    info,
+                };
+                let own = ctx.send_at(me, time.clone(), entering(Some(info)));
+                (own, ctx.send_at(ball, time, entering(None)))
+            }
+            None => {
+                let msg = SecMsg::SectorDeparture { ball, sector: me };
+                let own = ctx.send_at(me, time.clone(), msg.clone());
+                (own, ctx.send_at(ball, time, msg))
+            }
         };
-        let own = ctx.send_at(me, time.clone(), msg.clone());
-        let other = ctx.send_at(ball, time, msg);
         Passage {
             ball,
-            entry,
+            entry: version,
             own,
             other,
         }
@@ -799,7 +813,7 @@ impl Sectored {
         &self,
         ctx: &mut Ctx<'_, Sectored>,
         me: u32,
-        members: &[(u32, Key)],
+        members: &[(u32, u32)],
         planned: &mut Vec<Passage>,
         ball: u32,
         info: &Arc<BallInfo>,
@@ -846,23 +860,27 @@ impl Sectored {
         &self,
         ctx: &mut Ctx<'_, Sectored>,
         me: u32,
-        members: &mut Vec<(u32, Key)>,
+        members: &mut Vec<(u32, u32)>,
         planned: &mut Vec<Passage>,
         batch: &[Envelope<SecMsg>],
     ) {
         let poly = &self.layout.polys[(me - self.first_sector()) as usize];
         for env in batch {
             match &env.msg {
-                SecMsg::SectorEntry { ball, .. } => {
+                SecMsg::SectorEntry { ball, info, .. } => {
                     let Some(k) = planned
                         .iter()
                         .position(|p| p.ball == *ball && p.entry.is_some())
                     else {
                         continue;
                     };
-                    let info = planned.swap_remove(k).entry.expect("an entry");
-                    members.push((*ball, info.fixed.clone()));
-                    self.relay(ctx, me, members, planned, *ball, &info, None);
+                    let version = planned.swap_remove(k).entry;
+                    let info = info
+                        .as_ref()
+                        .expect("a sector's own entry carries the trajectory");
+                    debug_assert_eq!(version, Some(info.version), "the entry planned last");
+                    members.push((*ball, info.version));
+                    self.relay(ctx, me, members, planned, *ball, info, None);
                 }
                 SecMsg::SectorDeparture { ball, .. } => {
                     planned.retain(|p| p.ball != *ball);
@@ -870,8 +888,8 @@ impl Sectored {
                 }
                 SecMsg::VelocityChange { ball, info } => {
                     match members.iter().position(|m| m.0 == *ball) {
-                        Some(k) => members[k].1 = info.fixed.clone(),
-                        None => members.push((*ball, info.fixed.clone())),
+                        Some(k) => members[k].1 = info.version,
+                        None => members.push((*ball, info.version)),
                     }
                     if info.pocket.is_some() {
                         members.retain(|m| m.0 != *ball);
@@ -884,8 +902,8 @@ impl Sectored {
                 SecMsg::NewVelocity { ball, info } => {
                     if let Some(k) = members.iter().position(|m| m.0 == *ball) {
                         // a member: only news (its course changed out of our sight) matters
-                        if info.fixed > members[k].1 {
-                            members[k].1 = info.fixed.clone();
+                        if info.version > members[k].1 {
+                            members[k].1 = info.version;
                             if info.pocket.is_some() {
                                 members.retain(|m| m.0 != *ball);
                             }
@@ -893,9 +911,10 @@ impl Sectored {
                         }
                         continue;
                     }
-                    if planned.iter().any(|p| {
-                        p.ball == *ball && p.entry.as_ref().is_some_and(|e| e.fixed == info.fixed)
-                    }) {
+                    if planned
+                        .iter()
+                        .any(|p| p.ball == *ball && p.entry == Some(info.version))
+                    {
                         continue; // this entry is planned already
                     }
                     Self::cancel_passage(ctx, planned, *ball);
