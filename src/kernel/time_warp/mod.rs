@@ -45,6 +45,12 @@
 //! their output goes, in (virtual time, object) order, to the collector, and their saved states
 //! are freed (fossil collection). The transport and the reductions are a [`Fabric`]: threads
 //! ([`threads`]) or MPI ranks.
+//!
+//! On threads, a round starts when any worker has run a GVT interval of batches, for all of
+//! them at once ([`Fabric::round_due`]): a worker that runs mostly final batches, which cost
+//! less, would otherwise wait at every round for the others to run as many. What bounds a
+//! worker that runs ahead instead is its count of uncommitted batches: past two intervals'
+//! worth it runs only final batches until a round commits some.
 
 #[cfg(feature = "mpi")]
 pub mod mpi;
@@ -311,6 +317,13 @@ pub trait Fabric<M: Model>: Sync {
     /// tell: the published floors and the ops waiting in inboxes, read at one instant.
     fn peers_floor(&self, _me: usize) -> Option<Floor> {
         None
+    }
+    /// Whether worker `me`, with `done` GVT rounds behind it, starts a round now: when it is
+    /// due one itself (`due`), or, where workers share a trigger, when another asked for one.
+    /// A shared trigger brings the workers to a round together, so that one that runs its
+    /// batches faster (final ones) does not wait there for the others to run as many.
+    fn round_due(&self, _me: usize, _done: u64, due: bool) -> bool {
+        due
     }
 }
 
@@ -904,11 +917,20 @@ impl<M: Model> Worker<M> {
         ok
     }
 
-    /// Runs the next batch if its time is at most `limit`; false when there is none.
-    fn step<F: Fabric<M>>(&mut self, model: &M, fabric: &F, limit: f64) -> bool {
+    /// Runs the next batch if its time is at most `limit` (and, when `final_only`, if it may
+    /// run as final); false when there is none.
+    fn step<F: Fabric<M>>(&mut self, model: &M, fabric: &F, limit: f64, final_only: bool) -> bool {
         match self.next_time() {
             Some(t) if t <= limit => {}
             _ => return false,
+        }
+        let top = self.heap.peek().expect("a valid top");
+        // no floor ever passes a key deeper than it keeps: such a batch runs regardless
+        if final_only && top.p.time.key.depth() <= floor::DEPTH {
+            let (time, to) = (top.p.time.clone(), top.p.to);
+            if !self.may_run_final(fabric, &time, to) {
+                return false;
+            }
         }
         let first = self.heap.pop().expect("a valid top");
         let (time, to) = (first.p.time.clone(), first.p.to);
@@ -1273,6 +1295,8 @@ impl<M: Model> Worker<M> {
     ) -> Result<(), Stop> {
         let mut buf = Vec::new();
         let mut since = 0u32;
+        // uncommitted batches past which a worker runs only final ones
+        let ahead = 2 * cfg.gvt_interval as usize;
         self.ship = ship;
         self.final_ok = cfg.final_batches && fabric.shares_floors();
         self.flush(fabric);
@@ -1288,6 +1312,7 @@ impl<M: Model> Worker<M> {
                 None => 64,
             };
             let mut ran = 0;
+            let mut held_back = false;
             while ran < burst {
                 if self.uncommitted > cfg.max_uncommitted {
                     if self.uncommitted > cfg.max_uncommitted.saturating_mul(4) {
@@ -1296,24 +1321,27 @@ impl<M: Model> Worker<M> {
                     self.artificial_rollback();
                     limit = limit.min(self.gvt.t);
                 }
-                if !self.step(model, fabric, limit) {
+                // far ahead of GVT: only batches that cannot be undone, until a round (another
+                // worker's, or this one's own once it has waited a round's worth) commits
+                held_back = self.final_ok && self.uncommitted > ahead;
+                if !self.step(model, fabric, limit, held_back) {
                     break;
                 }
                 ran += 1;
             }
             self.flush(fabric);
             since += ran.max(1);
-            if ran == 0 {
+            if ran == 0 && !held_back {
                 since = cfg.gvt_interval;
-                if self.chaos.is_none() {
-                    std::thread::yield_now();
-                }
+            }
+            if ran == 0 && self.chaos.is_none() {
+                std::thread::yield_now();
             }
             let over = self.uncommitted > cfg.max_uncommitted.saturating_mul(4);
             if over || self.fault.is_some() {
                 since = cfg.gvt_interval;
             }
-            if since < cfg.gvt_interval {
+            if !fabric.round_due(self.index, self.round, since >= cfg.gvt_interval) {
                 continue;
             }
             since = 0;

@@ -69,6 +69,8 @@ struct Slot<Msg> {
 pub struct ThreadFabric<M: Model> {
     slots: Vec<Mutex<Slot<M::Msg>>>,
     reduce: ThreadReduce,
+    /// GVT rounds asked for so far (by any worker): every worker with fewer behind it starts one.
+    rounds_asked: AtomicU64,
     collector: mpsc::Sender<Chunk<M::State, M::Output>>,
 }
 
@@ -90,6 +92,7 @@ where
                 })
                 .collect(),
             reduce: ThreadReduce::new(n),
+            rounds_asked: AtomicU64::new(0),
             collector,
         }
     }
@@ -144,6 +147,14 @@ where
 
     fn shares_floors(&self) -> bool {
         true
+    }
+
+    fn round_due(&self, _me: usize, done: u64, due: bool) -> bool {
+        if due {
+            self.rounds_asked.fetch_max(done + 1, Ordering::Relaxed);
+            return true;
+        }
+        self.rounds_asked.load(Ordering::Relaxed) > done
     }
 
     fn publish(&self, me: usize, floor: Floor) {
@@ -569,6 +580,19 @@ mod tests {
 
     fn at(t: f64) -> VTime {
         VTime::at(Key::start(t))
+    }
+
+    #[test]
+    fn a_round_one_worker_is_due_brings_every_worker() {
+        let (tx, _rx) = mpsc::channel();
+        let f: ThreadFabric<Numbers> = ThreadFabric::new(3, tx);
+        assert!(!f.round_due(1, 0, false), "nobody asked yet");
+        assert!(f.round_due(0, 0, true));
+        assert!(f.round_due(1, 0, false) && f.round_due(2, 0, false));
+        // once a worker has had that round, it waits for the next one asked
+        assert!(!f.round_due(1, 1, false));
+        assert!(f.round_due(2, 1, true));
+        assert!(f.round_due(0, 1, false) && !f.round_due(0, 2, false));
     }
 
     #[test]
