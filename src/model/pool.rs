@@ -53,7 +53,7 @@ pub struct BallInfo {
     pub fixed: Key,
     /// How many times `fixed` has changed: it orders one ball's trajectories as `fixed` does,
     /// in a word that a sector's state or a message can copy for nothing.
-    pub version: u32,
+    pub version: u64,
     /// The pocket it dropped into.
     pub pocket: Option<u32>,
 }
@@ -675,5 +675,37 @@ impl Model for Pool {
                 self.next_frame(ctx, me, frames);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Vec2;
+
+    #[test]
+    fn a_version_counts_the_keys_a_trajectory_was_fixed_at() {
+        let mut info = BallInfo {
+            traj: Trajectory {
+                position: Vec2::new(0.0, 0.0),
+                velocity: Vec2::new(1.0, 0.0),
+                t0: 0.0,
+            },
+            radius: 1.0,
+            mass: 1.0,
+            fixed: Key::start(0.0),
+            version: 0,
+            pocket: None,
+        };
+        info.fix(&Key::start(0.0));
+        assert_eq!(
+            info.version, 0,
+            "fixed again where it was: the same trajectory version"
+        );
+        info.fix(&Key::at(1.0, pair(0, 1)));
+        info.fix(&Key::at(1.0, pair(0, 1)));
+        info.fix(&Key::at(2.0, pair(0, 2)));
+        assert_eq!(info.version, 2);
+        assert_eq!(info.fixed, Key::at(2.0, pair(0, 2)));
     }
 }

@@ -234,7 +234,7 @@ pub enum SecMsg {
         /// The partner ball's trajectory as the scheduler knew it.
         info: Option<Arc<BallInfo>>,
         /// The receiver's trajectory version as the scheduler knew it.
-        seen: u32,
+        seen: u64,
     },
     /// Turn around now (thesis 4.6), sent by each ball to itself at the start.
     ReverseYourself,
@@ -300,7 +300,7 @@ pub struct Passage {
     pub ball: u32,
     /// For an entry, the version of the ball's trajectory it was computed from; `None` for a
     /// departure.
-    pub entry: Option<u32>,
+    pub entry: Option<u64>,
     /// The message to the sector itself.
     pub own: Handle,
     /// The message to the ball.
@@ -331,7 +331,7 @@ pub enum SecState {
         /// Balls whose disks touch it, with the version ([`BallInfo::version`]) of their
         /// trajectories as last heard: a word, not the trajectory or its key, so that saving the
         /// state is one plain copy.
-        members: Vec<(u32, u32)>,
+        members: Vec<(u32, u64)>,
         /// Entries and departures it scheduled.
         planned: Vec<Passage>,
     },
@@ -355,7 +355,7 @@ impl Sectored {
         let table = Table::new(s);
         let n = table.n_balls;
         let first_sector = n + table.n_fixed();
-        let mut members: Vec<Vec<(u32, u32)>> = vec![Vec::new(); layout.polys.len()];
+        let mut members: Vec<Vec<(u32, u64)>> = vec![Vec::new(); layout.polys.len()];
         let mut states: Vec<SecState> = Vec::new();
         for (i, b) in s.balls.iter().enumerate() {
             let info = Arc::new(BallInfo {
@@ -468,9 +468,9 @@ impl Sectored {
         partner: u32,
         key: Key,
         mine: Option<Arc<BallInfo>>,
-        my_version: u32,
+        my_version: u64,
         theirs: Option<Arc<BallInfo>>,
-        their_version: u32,
+        their_version: u64,
     ) -> Planned {
         let time = VTime::at(key);
         let own = ctx.send_at(
@@ -813,7 +813,7 @@ impl Sectored {
         &self,
         ctx: &mut Ctx<'_, Sectored>,
         me: u32,
-        members: &[(u32, u32)],
+        members: &[(u32, u64)],
         planned: &mut Vec<Passage>,
         ball: u32,
         info: &Arc<BallInfo>,
@@ -860,7 +860,7 @@ impl Sectored {
         &self,
         ctx: &mut Ctx<'_, Sectored>,
         me: u32,
-        members: &mut Vec<(u32, u32)>,
+        members: &mut Vec<(u32, u64)>,
         planned: &mut Vec<Passage>,
         batch: &[Envelope<SecMsg>],
     ) {

@@ -924,12 +924,14 @@ impl<M: Model> Worker<M> {
             Some(t) if t <= limit => {}
             _ => return false,
         }
-        let top = self.heap.peek().expect("a valid top");
-        // no floor ever passes a key deeper than it keeps: such a batch runs regardless
-        if final_only && top.p.time.key.depth() <= floor::DEPTH {
-            let (time, to) = (top.p.time.clone(), top.p.to);
-            if !self.may_run_final(fabric, &time, to) {
-                return false;
+        if final_only {
+            let top = self.heap.peek().expect("a valid top");
+            // no floor ever passes a key deeper than it keeps: such a batch runs regardless
+            if top.p.time.key.depth() <= floor::DEPTH {
+                let (time, to) = (top.p.time.clone(), top.p.to);
+                if !self.may_run_final(fabric, &time, to) {
+                    return false;
+                }
             }
         }
         let first = self.heap.pop().expect("a valid top");
