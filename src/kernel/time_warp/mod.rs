@@ -926,12 +926,11 @@ impl<M: Model> Worker<M> {
         }
         if final_only {
             let top = self.heap.peek().expect("a valid top");
-            // no floor ever passes a key deeper than it keeps: such a batch runs regardless
-            if top.p.time.key.depth() <= floor::DEPTH {
-                let (time, to) = (top.p.time.clone(), top.p.to);
-                if !self.may_run_final(fabric, &time, to) {
-                    return false;
-                }
+            let (time, to) = (top.p.time.clone(), top.p.to);
+            // the first batch left at the last GVT round runs regardless: no floor ever passes
+            // a key deeper than it keeps
+            if Floor::of(&time, to) > self.gvt && !self.may_run_final(fabric, &time, to) {
+                return false;
             }
         }
         let first = self.heap.pop().expect("a valid top");
@@ -976,8 +975,10 @@ impl<M: Model> Worker<M> {
             }
         }
         let lp = &mut self.lps[li];
-        if time.key.depth() > MAX_CASCADE_DEPTH {
-            // GVT cannot pass an instant this deep, so it would pile up batches until memory ran out
+        // GVT cannot pass an instant this deep, so it would pile up batches until memory ran
+        // out; a cascade run on a state still to be rolled back may be wrong, and is stopped by
+        // the bound on uncommitted batches instead, until GVT reaches it
+        if time.key.depth() > MAX_CASCADE_DEPTH && (run_final || Floor::of(&time, to) <= self.gvt) {
             self.fault.get_or_insert(format!(
                 "a cascade of zero-delay events at t = {} is over {MAX_CASCADE_DEPTH} steps deep \
                  and does not end (a ball wedged between cushions or balls?)",
