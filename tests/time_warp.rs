@@ -378,4 +378,10 @@ fn batches_run_as_final_beside_optimistic_ones() {
         finals < committed,
         "every batch ran as final on 2 workers: {tw}"
     );
+    // optimistic batches are committed as soon as nothing can undo them, not only at rounds
+    let early = tw["committed_early"].as_u64().unwrap();
+    assert!(
+        early > 0 && early <= committed - finals,
+        "{early} committed early: {tw}"
+    );
 }

@@ -124,6 +124,9 @@ pub struct TwStats {
     /// Of them, batches run as final: before every op another worker could still send, so
     /// without saving state (counted in `processed` too).
     pub final_batches: u64,
+    /// Of the others, batches committed between GVT rounds, as soon as nothing could undo
+    /// them any more (threads only).
+    pub committed_early: u64,
     /// Batches undone by rollbacks.
     pub rolled_back: u64,
     /// Rollbacks (one object rolled back once).
@@ -166,6 +169,7 @@ impl TwStats {
         self.processed += o.processed;
         self.committed += o.committed;
         self.final_batches += o.final_batches;
+        self.committed_early += o.committed_early;
         self.rolled_back += o.rolled_back;
         self.rollbacks += o.rollbacks;
         self.artificial_rollbacks += o.artificial_rollbacks;
@@ -587,6 +591,8 @@ pub struct Worker<M: Model> {
     fault: Option<String>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
+    /// Objects in the order their optimistic batches ran, to commit them early.
+    ran: VecDeque<u32>,
     /// Whether batches may run as final ([`TwConfig::final_batches`]).
     final_ok: bool,
     /// Whether the collector wants observed objects' states.
@@ -667,6 +673,7 @@ impl<M: Model> Worker<M> {
             samples: Vec::new(),
             fault: None,
             active: Vec::new(),
+            ran: VecDeque::new(),
             final_ok: false,
             ship: false,
             final_bound: Floor::NEG_INFINITY,
@@ -1061,6 +1068,7 @@ impl<M: Model> Worker<M> {
                 self.active.push(li as u32);
             }
             lp.history.push_back(done);
+            self.ran.push_back(li as u32);
             self.uncommitted += 1;
             self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
         }
@@ -1249,6 +1257,27 @@ impl<M: Model> Worker<M> {
         }
     }
 
+    /// Commits optimistic batches, oldest run first, that nothing can undo any more: before
+    /// every op the other workers may still send and before this worker's own next batch.
+    fn commit_early(&mut self, model: &M) {
+        if !self.final_ok || self.ran.is_empty() {
+            return;
+        }
+        let bound = self.final_bound.min(self.local_min());
+        let before = self.uncommitted;
+        while let Some(&li) = self.ran.front() {
+            let li = li as usize;
+            let lp = &self.lps[li];
+            match lp.history.front() {
+                None => {}
+                Some(d) if bound.passed(&d.time, lp.id) => self.commit_front(model, li, &bound),
+                Some(_) => break,
+            }
+            self.ran.pop_front();
+        }
+        self.stats.committed_early += (before - self.uncommitted) as u64;
+    }
+
     /// Commits every batch before `gvt`: frees its saved state and messages, and returns what
     /// the collector needs of every batch committed so far that `gvt` passed (output, and
     /// observed states when the collector wants them), in no particular order.
@@ -1332,6 +1361,7 @@ impl<M: Model> Worker<M> {
                 }
                 ran += 1;
             }
+            self.commit_early(model);
             self.flush(fabric);
             since += ran.max(1);
             if ran == 0 && !held_back {
@@ -1344,7 +1374,14 @@ impl<M: Model> Worker<M> {
             if over || self.fault.is_some() {
                 since = cfg.gvt_interval;
             }
-            if !fabric.round_due(self.index, self.round, since >= cfg.gvt_interval) {
+            // chaos keeps each worker to its own count: the lockstep of the old rounds damps the
+            // rollback echoes that its delays provoke, which otherwise may run for seconds
+            let due = since >= cfg.gvt_interval;
+            let go = match self.chaos {
+                Some(_) => due,
+                None => fabric.round_due(self.index, self.round, due),
+            };
+            if !go {
                 continue;
             }
             since = 0;
