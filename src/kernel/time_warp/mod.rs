@@ -593,6 +593,8 @@ pub struct Worker<M: Model> {
     active: Vec<u32>,
     /// Objects in the order their optimistic batches ran, to commit them early.
     ran: VecDeque<u32>,
+    /// The floor this worker published last (with final batches only).
+    published: Floor,
     /// Whether batches may run as final ([`TwConfig::final_batches`]).
     final_ok: bool,
     /// Whether the collector wants observed objects' states.
@@ -674,6 +676,7 @@ impl<M: Model> Worker<M> {
             fault: None,
             active: Vec::new(),
             ran: VecDeque::new(),
+            published: Floor::NEG_INFINITY,
             final_ok: false,
             ship: false,
             final_bound: Floor::NEG_INFINITY,
@@ -1145,6 +1148,7 @@ impl<M: Model> Worker<M> {
         if self.final_ok {
             let floor = self.local_min();
             fabric.publish(self.index, floor);
+            self.published = floor;
         }
     }
 
@@ -1263,7 +1267,9 @@ impl<M: Model> Worker<M> {
         if !self.final_ok || self.ran.is_empty() {
             return;
         }
-        let bound = self.final_bound.min(self.local_min());
+        // the floor just published is this worker's own next batch; the ops it flushed are
+        // still under `final_bound`
+        let bound = self.final_bound.min(self.published);
         let before = self.uncommitted;
         while let Some(&li) = self.ran.front() {
             let li = li as usize;
@@ -1361,8 +1367,8 @@ impl<M: Model> Worker<M> {
                 }
                 ran += 1;
             }
-            self.commit_early(model);
             self.flush(fabric);
+            self.commit_early(model);
             since += ran.max(1);
             if ran == 0 && !held_back {
                 since = cfg.gvt_interval;
