@@ -63,7 +63,7 @@ pub use floor::Floor;
 use marks::{Mark, Marks};
 
 use super::queue::Queue;
-use super::{Ctx, Envelope, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
+use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
 use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -463,6 +463,16 @@ struct Done<M: Model> {
     into_past: Option<String>,
 }
 
+/// What a batch run as final did, for [`Worker::commit_final`].
+struct Did<'a, M: Model> {
+    time: VTime,
+    /// Messages it handled.
+    delivered: usize,
+    cancelled: &'a [Handle],
+    output: Vec<M::Output>,
+    into_past: Option<String>,
+}
+
 /// One object (a logical process) on its worker.
 struct Lp<M: Model> {
     id: u32,
@@ -606,6 +616,8 @@ pub struct Worker<M: Model> {
     bound_wait: u32,
     /// The last batch run as final: no op may come at or before it.
     final_floor: Floor,
+    /// The latest batch run optimistically: no uncommitted batch is later.
+    high: Option<VTime>,
     /// Below every op in the outboxes.
     outbox_floor: Floor,
     /// What the collector needs of committed batches, until the chunk of the first GVT round
@@ -682,6 +694,7 @@ impl<M: Model> Worker<M> {
             final_bound: Floor::NEG_INFINITY,
             bound_wait: 0,
             final_floor: Floor::NEG_INFINITY,
+            high: None,
             outbox_floor: Floor::INFINITY,
             to_ship: Vec::new(),
         }
@@ -712,7 +725,7 @@ impl<M: Model> Worker<M> {
                         },
                     );
                 }
-                self.route(Op::Msg { uid, p });
+                self.send(uid, p);
             }
         }
         self.drain_local();
@@ -754,15 +767,8 @@ impl<M: Model> Worker<M> {
     /// Sends an op on its way.
     fn route(&mut self, op: Op<M::Msg>) {
         let w = self.placement.worker(op.to());
-        match &op {
-            Op::Msg { .. } => {
-                self.stats.messages += 1;
-                if w != self.index {
-                    self.stats.remote_messages += 1;
-                }
-            }
-            Op::Anti { .. } => self.stats.anti_messages += 1,
-            Op::Cancel { .. } | Op::Retract { .. } => {}
+        if let Op::Anti { .. } = op {
+            self.stats.anti_messages += 1;
         }
         if w == self.index {
             self.local_ops.push(op);
@@ -800,7 +806,7 @@ impl<M: Model> Worker<M> {
                     self.marks.set_aside(uid, p, Mark::Cancelled);
                     return;
                 }
-                if self.lps[li].last_time().is_some_and(|t| *t >= p.time) {
+                if self.ran_past(li, &p.time) {
                     self.rollback(li, &p.time); // a straggler
                 }
                 self.push(Item { uid, p });
@@ -813,7 +819,7 @@ impl<M: Model> Worker<M> {
                 }
                 // if a batch handled it, the message is back in the heap after this, and the
                 // mark drops it there
-                if self.lps[li].last_time().is_some_and(|t| *t >= time) {
+                if self.ran_past(li, &time) {
                     self.rollback(li, &time);
                 }
             }
@@ -826,9 +832,7 @@ impl<M: Model> Worker<M> {
             } => {
                 let before = self.marks.cancelled(uid);
                 let back = self.marks.cancel(uid, time.t(), at, sign);
-                if before != self.marks.cancelled(uid)
-                    && self.lps[li].last_time().is_some_and(|t| *t >= time)
-                {
+                if before != self.marks.cancelled(uid) && self.ran_past(li, &time) {
                     self.rollback(li, &time);
                 }
                 if let Some(p) = back {
@@ -836,8 +840,7 @@ impl<M: Model> Worker<M> {
                 }
             }
         }
-        let held = self.heap.len() + self.marks.set_aside_len();
-        self.stats.peak_entries = self.stats.peak_entries.max(held as u64);
+        self.note_entries();
     }
 
     /// Puts a message in the heap, in the instant's tier if it is for the key being run.
@@ -948,25 +951,6 @@ impl<M: Model> Worker<M> {
         if self.current != time.key {
             self.current = time.key.clone();
         }
-        let mut inputs = take(&mut self.spare.inputs);
-        let mut batch = take(&mut self.spare.batches);
-        let (input, env) = first.into_input();
-        inputs.push(input);
-        batch.push(env);
-        while let Some(top) = self.heap.peek() {
-            if top.p.time != time || top.p.to != to {
-                break;
-            }
-            let it = self.heap.pop().expect("a top");
-            match self.marks.of(it.uid, it.p.retractable) {
-                Mark::Live => {
-                    let (input, env) = it.into_input();
-                    inputs.push(input);
-                    batch.push(env);
-                }
-                mark => self.marks.set_aside(it.uid, it.p, mark),
-            }
-        }
         let li = self.placement.local(to);
         debug_assert!(
             self.lps[li].last_time().is_none_or(|t| *t < time),
@@ -982,6 +966,30 @@ impl<M: Model> Worker<M> {
             run_final = self.lps[li].history.is_empty();
             if run_final {
                 self.final_floor = here;
+            }
+        }
+        // a batch run as final is never put back, so it keeps no names of its messages
+        let mut inputs = take(&mut self.spare.inputs);
+        let mut batch = take(&mut self.spare.batches);
+        let (input, env) = first.into_input();
+        if !run_final {
+            inputs.push(input);
+        }
+        batch.push(env);
+        while let Some(top) = self.heap.peek() {
+            if top.p.time != time || top.p.to != to {
+                break;
+            }
+            let it = self.heap.pop().expect("a top");
+            match self.marks.of(it.uid, it.p.retractable) {
+                Mark::Live => {
+                    let (input, env) = it.into_input();
+                    if !run_final {
+                        inputs.push(input);
+                    }
+                    batch.push(env);
+                }
+                mark => self.marks.set_aside(it.uid, it.p, mark),
             }
         }
         let lp = &mut self.lps[li];
@@ -1002,85 +1010,189 @@ impl<M: Model> Worker<M> {
         model.handle(&mut ctx, to, &mut lp.state, &batch);
         let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
         let into_past = ctx.into_past;
-        let mut ops = std::mem::take(&mut self.spare.ops);
-        let mut sent_recs = take(&mut self.spare.sent);
-        for p in sent.drain(..) {
-            let uid = lp.next_uid();
-            let s = Sent {
-                uid,
-                seq: p.env.seq,
-                to: p.to,
-                retractable: p.retractable,
-                time: p.time.clone(),
-            };
-            sent_recs.push((s, model.kind(&p.env.msg) as u16));
-            ops.push(Op::Msg { uid, p });
-        }
-        self.spare.pending = sent;
-        let mut cancels = Vec::new();
-        for h in &cancelled {
-            let this_batch = sent_recs.binary_search_by_key(&h.seq, |(s, _)| s.seq);
-            let s = match this_batch {
-                Ok(i) => Some(&sent_recs[i].0),
-                Err(_) => lp.sent(h.seq),
-            };
-            if let Some(s) = s {
-                // after this batch in the sequential order: not delivered yet
-                if (&s.time, s.to) > (&time, to) {
-                    cancels.push(s.clone());
-                }
-            }
-        }
-        for c in &cancels {
-            // the cancelled message's receiver and time, not this batch's
-            let (uid, to, t) = (c.uid, c.to, c.time.clone());
-            ops.push(if run_final {
-                Op::Retract { uid, to, time: t }
-            } else {
-                Op::Cancel {
-                    uid,
-                    to,
-                    time: t,
-                    sign: 1,
-                    at: time.t(),
-                }
-            });
-        }
-        let done = Done {
-            time,
-            pre_state,
-            pre_seq,
-            inputs,
-            batch,
-            sent: sent_recs,
-            cancels,
-            cancel_calls: cancelled.len() as u32,
-            output,
-            into_past,
-        };
         self.stats.processed += 1;
+        let mut ops = std::mem::take(&mut self.spare.ops);
         if run_final {
             self.stats.final_batches += 1;
-            let state = (self.ship && model.observed(to)).then(|| lp.state.clone());
-            let (gvt, floor) = (self.gvt, self.final_floor);
-            self.commit(li, done, state, &floor);
-            self.lps[li].sweep_sends(&gvt);
+            let delivered = batch.len();
+            give(&mut self.spare.inputs, inputs);
+            give(&mut self.spare.batches, batch);
+            let did = Did {
+                time,
+                delivered,
+                cancelled: &cancelled,
+                output,
+                into_past,
+            };
+            self.commit_final(model, li, did, &mut sent, &mut ops);
         } else {
+            let mut sent_recs = take(&mut self.spare.sent);
+            for p in sent.drain(..) {
+                let uid = lp.next_uid();
+                let s = Sent {
+                    uid,
+                    seq: p.env.seq,
+                    to: p.to,
+                    retractable: p.retractable,
+                    time: p.time.clone(),
+                };
+                sent_recs.push((s, model.kind(&p.env.msg) as u16));
+                ops.push(Op::Msg { uid, p });
+            }
+            let mut cancels = Vec::new();
+            for h in &cancelled {
+                let this_batch = sent_recs.binary_search_by_key(&h.seq, |(s, _)| s.seq);
+                let s = match this_batch {
+                    Ok(i) => Some(&sent_recs[i].0),
+                    Err(_) => lp.sent(h.seq),
+                };
+                if let Some(s) = s {
+                    // after this batch in the sequential order: not delivered yet
+                    if (&s.time, s.to) > (&time, to) {
+                        cancels.push(s.clone());
+                    }
+                }
+            }
+            for c in &cancels {
+                // the cancelled message's receiver and time, not this batch's
+                ops.push(Op::Cancel {
+                    uid: c.uid,
+                    to: c.to,
+                    time: c.time.clone(),
+                    sign: 1,
+                    at: time.t(),
+                });
+            }
             if !lp.active {
                 lp.active = true;
                 self.active.push(li as u32);
             }
-            lp.history.push_back(done);
+            if self.high.as_ref().is_none_or(|h| *h < time) {
+                self.high = Some(time.clone());
+            }
+            lp.history.push_back(Done {
+                time,
+                pre_state,
+                pre_seq,
+                inputs,
+                batch,
+                sent: sent_recs,
+                cancels,
+                cancel_calls: cancelled.len() as u32,
+                output,
+                into_past,
+            });
             self.ran.push_back(li as u32);
             self.uncommitted += 1;
             self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
         }
+        self.spare.pending = sent;
         for op in ops.drain(..) {
-            self.route(op);
+            match op {
+                Op::Msg { uid, p } => self.send(uid, p),
+                op => self.route(op),
+            }
         }
         self.spare.ops = ops;
         self.drain_local();
         true
+    }
+
+    /// Commits a batch that ran as final at once, keeping no record of it: counts it, files
+    /// its sends that a later batch may still cancel, and turns its cancellations into
+    /// retractions. Its sends and retractions go to `ops`.
+    fn commit_final(
+        &mut self,
+        model: &M,
+        li: usize,
+        did: Did<'_, M>,
+        sent: &mut Vec<Pending<M::Msg>>,
+        ops: &mut Vec<Op<M::Msg>>,
+    ) {
+        if let Some(what) = did.into_past {
+            self.fault
+                .get_or_insert(format!("model bug in a committed batch: {what}"));
+        }
+        self.stats.committed += 1;
+        let cs = &mut self.committed_stats;
+        cs.batches += 1;
+        cs.delivered += did.delivered as u64;
+        cs.cancels += did.cancelled.len() as u64;
+        let lp = &mut self.lps[li];
+        for p in sent.drain(..) {
+            cs.count(model.kind(&p.env.msg));
+            let uid = lp.next_uid();
+            // every send comes after this batch: a later one may still cancel it
+            if p.retractable {
+                let s = Sent {
+                    uid,
+                    seq: p.env.seq,
+                    to: p.to,
+                    retractable: true,
+                    time: p.time.clone(),
+                };
+                lp.sends.insert(s.seq, s);
+            }
+            ops.push(Op::Msg { uid, p });
+        }
+        for h in did.cancelled {
+            // a committed cancellation is final: its message needs no name any more
+            if let Some(s) = lp.sends.remove(&h.seq) {
+                // after this batch in the sequential order: not delivered yet
+                if (&s.time, s.to) > (&did.time, lp.id) {
+                    ops.push(Op::Retract {
+                        uid: s.uid,
+                        to: s.to,
+                        time: s.time,
+                    });
+                }
+            }
+        }
+        let id = lp.id;
+        let state = (self.ship && model.observed(id)).then(|| lp.state.clone());
+        if state.is_some() || !did.output.is_empty() {
+            self.to_ship.push(Committed {
+                time: did.time,
+                obj: id,
+                state,
+                output: did.output,
+            });
+        }
+        let gvt = self.gvt;
+        self.lps[li].sweep_sends(&gvt);
+    }
+
+    /// Sends a message a batch (or `init`) of this worker has just made. On this worker it goes
+    /// straight to the heap: no mark can name it yet, and only an object that ran past it since
+    /// a rollback needs rolling back.
+    fn send(&mut self, uid: u64, p: Pending<M::Msg>) {
+        self.stats.messages += 1;
+        let w = self.placement.worker(p.to);
+        if w != self.index {
+            self.stats.remote_messages += 1;
+            self.route(Op::Msg { uid, p });
+            return;
+        }
+        debug_assert!(!self.final_floor.reaches(&p.time, p.to), "sends go forward");
+        let li = self.placement.local(p.to);
+        if self.ran_past(li, &p.time) {
+            self.rollback(li, &p.time);
+        }
+        self.push(Item { uid, p });
+        self.note_entries();
+    }
+
+    /// Whether local object `li` ran a batch at `time` or later that is not committed yet.
+    fn ran_past(&self, li: usize, time: &VTime) -> bool {
+        // no batch ran past the latest one run: most messages are later than it
+        self.high.as_ref().is_some_and(|h| h >= time)
+            && self.lps[li].last_time().is_some_and(|t| t >= time)
+    }
+
+    /// Notes how many messages this worker holds, for the summary's peak.
+    fn note_entries(&mut self) {
+        let held = self.heap.len() + self.marks.set_aside_len();
+        self.stats.peak_entries = self.stats.peak_entries.max(held as u64);
     }
 
     /// Rolls back every object that ran past the next message here, to free saved states, when
