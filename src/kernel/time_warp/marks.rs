@@ -38,6 +38,9 @@ pub enum Mark {
 pub struct Marks<Msg> {
     /// Anti-messages whose message has not been dropped yet (it is in the heap or on its way).
     annulled: FxHashSet<u64>,
+    /// Retractions (cancellations by batches run as final) likewise: kept apart because they
+    /// name only messages their sender may cancel, so that the many others need no lookup.
+    retracted: FxHashSet<u64>,
     /// Model cancellations, by the uid of the cancelled message.
     cancels: FxHashMap<u64, Cancels>,
     /// Cancelled messages taken off the heap, by uid: undoing the cancellation brings them back.
@@ -51,6 +54,7 @@ impl<Msg> Default for Marks<Msg> {
     fn default() -> Self {
         Marks {
             annulled: FxHashSet::default(),
+            retracted: FxHashSet::default(),
             cancels: FxHashMap::default(),
             dead: FxHashMap::default(),
             sweep_at: 1024,
@@ -64,7 +68,11 @@ impl<Msg> Marks<Msg> {
     pub fn of(&self, uid: u64, retractable: bool) -> Mark {
         if !self.annulled.is_empty() && self.annulled.contains(&uid) {
             Mark::Annulled
-        } else if retractable && self.cancelled(uid) {
+        } else if !retractable {
+            Mark::Live
+        } else if !self.retracted.is_empty() && self.retracted.contains(&uid) {
+            Mark::Annulled
+        } else if self.cancelled(uid) {
             Mark::Cancelled
         } else {
             Mark::Live
@@ -81,9 +89,7 @@ impl<Msg> Marks<Msg> {
     /// anti-message is spent), a cancelled one set aside.
     pub fn set_aside(&mut self, uid: u64, p: Pending<Msg>, mark: Mark) {
         match mark {
-            Mark::Annulled => {
-                self.annulled.remove(&uid);
-            }
+            Mark::Annulled => self.unmark(uid),
             Mark::Cancelled => {
                 self.dead.insert(uid, p);
             }
@@ -91,9 +97,19 @@ impl<Msg> Marks<Msg> {
         }
     }
 
-    /// A message arriving: false if its anti-message came first (both are then spent).
-    pub fn arrives(&mut self, uid: u64) -> bool {
-        self.annulled.is_empty() || !self.annulled.remove(&uid)
+    /// Spends the anti-message or retraction of a message dropped.
+    fn unmark(&mut self, uid: u64) {
+        if !self.annulled.remove(&uid) {
+            self.retracted.remove(&uid);
+        }
+    }
+
+    /// A message arriving: false if its anti-message or retraction came first (both are then
+    /// spent).
+    pub fn arrives(&mut self, uid: u64, retractable: bool) -> bool {
+        let annulled = !self.annulled.is_empty() && self.annulled.remove(&uid);
+        let retracted = retractable && !self.retracted.is_empty() && self.retracted.remove(&uid);
+        !(annulled || retracted)
     }
 
     /// An anti-message: drops its message if it is set aside here, else marks it, to be dropped
@@ -104,6 +120,15 @@ impl<Msg> Marks<Msg> {
             return true;
         }
         self.annulled.insert(uid);
+        false
+    }
+
+    /// A retraction: as [`Marks::annul`], for a message its sender may cancel.
+    pub fn retract(&mut self, uid: u64) -> bool {
+        if self.dead.remove(&uid).is_some() {
+            return true;
+        }
+        self.retracted.insert(uid);
         false
     }
 
@@ -138,7 +163,7 @@ impl<Msg> Marks<Msg> {
 
     /// Marks waiting for messages still in the heap or on their way.
     pub fn pending_marks(&self) -> usize {
-        self.annulled.len() + self.cancels.len()
+        self.annulled.len() + self.retracted.len() + self.cancels.len()
     }
 
     /// Whether a heap item stays: drops (and unmarks) an annulled message, and a cancelled one
@@ -147,7 +172,7 @@ impl<Msg> Marks<Msg> {
         match self.of(uid, retractable) {
             Mark::Live => true,
             Mark::Annulled => {
-                self.annulled.remove(&uid);
+                self.unmark(uid);
                 false
             }
             Mark::Cancelled => {
@@ -208,12 +233,32 @@ mod tests {
         // the anti-message first: the message is dropped as it arrives
         assert!(!m.annul(7));
         assert_eq!(m.of(7, false), Mark::Annulled);
-        assert!(!m.arrives(7));
+        assert!(!m.arrives(7, false));
         assert_eq!(m.of(7, true), Mark::Live);
         // the message first, in the heap: it is dropped when it reaches the top
-        assert!(m.arrives(8));
+        assert!(m.arrives(8, true));
         m.annul(8);
         m.set_aside(8, msg(1.0), Mark::Annulled);
+        assert_eq!(m.pending_marks(), 0);
+    }
+
+    #[test]
+    fn a_retraction_names_only_a_message_its_sender_may_cancel() {
+        let mut m: Marks<u8> = Marks::default();
+        assert!(!m.retract(5));
+        assert_eq!(m.of(5, true), Mark::Annulled);
+        // a relay is never retracted, so its lookups skip the retractions
+        assert_eq!(m.of(5, false), Mark::Live);
+        assert!(!m.arrives(5, true), "retracted before it came");
+        assert_eq!((m.of(5, true), m.pending_marks()), (Mark::Live, 0));
+        // a message set aside as cancelled is dropped at once
+        m.cancel(6, 2.0, 1.0, 1);
+        m.set_aside(6, msg(2.0), Mark::Cancelled);
+        assert!(m.retract(6));
+        assert_eq!(m.set_aside_len(), 0);
+        // one in the heap is dropped when it reaches the top, which spends the mark
+        m.retract(7);
+        assert!(!m.keeps(7, true, 0.0));
         assert_eq!(m.pending_marks(), 0);
     }
 

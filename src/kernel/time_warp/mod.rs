@@ -799,8 +799,8 @@ impl<M: Model> Worker<M> {
         let li = self.placement.local(to);
         match op {
             Op::Msg { uid, p } => {
-                if !self.marks.arrives(uid) {
-                    return; // its anti-message came first
+                if !self.marks.arrives(uid, p.retractable) {
+                    return; // its anti-message or retraction came first
                 }
                 if p.retractable && self.marks.cancelled(uid) {
                     self.marks.set_aside(uid, p, Mark::Cancelled);
@@ -811,16 +811,17 @@ impl<M: Model> Worker<M> {
                 }
                 self.push(Item { uid, p });
             }
-            Op::Anti { uid, time, .. } | Op::Retract { uid, time, .. } => {
+            Op::Anti { uid, time, .. } => {
                 // a cancelled message was handled by no batch that stands
                 let unseen = self.marks.cancelled(uid);
-                if self.marks.annul(uid) || unseen {
-                    return;
+                if !self.marks.annul(uid) && !unseen {
+                    self.undo_handling(li, &time);
                 }
-                // if a batch handled it, the message is back in the heap after this, and the
-                // mark drops it there
-                if self.ran_past(li, &time) {
-                    self.rollback(li, &time);
+            }
+            Op::Retract { uid, time, .. } => {
+                let unseen = self.marks.cancelled(uid);
+                if !self.marks.retract(uid) && !unseen {
+                    self.undo_handling(li, &time);
                 }
             }
             Op::Cancel {
@@ -841,6 +842,14 @@ impl<M: Model> Worker<M> {
             }
         }
         self.note_entries();
+    }
+
+    /// Rolls local object `li` back if it may have handled a message at `time` that is gone:
+    /// the message is back in the heap after this, and its mark drops it there.
+    fn undo_handling(&mut self, li: usize, time: &VTime) {
+        if self.ran_past(li, time) {
+            self.rollback(li, time);
+        }
     }
 
     /// Puts a message in the heap, in the instant's tier if it is for the key being run.
