@@ -1108,15 +1108,15 @@ impl<M: Model> Worker<M> {
     }
 
     /// Commits a batch that ran as final at once, keeping no record of it: counts it, files
-    /// its sends that a later batch may still cancel, and turns its cancellations into
-    /// retractions. Its sends and retractions go to `ops`.
+    /// its sends that a later batch may still cancel, sends them, and turns its cancellations
+    /// into retractions (collected in `retracts`, emptied).
     fn commit_final(
         &mut self,
         model: &M,
         li: usize,
         did: Did<'_, M>,
         sent: &mut Vec<Pending<M::Msg>>,
-        ops: &mut Vec<Op<M::Msg>>,
+        retracts: &mut Vec<Op<M::Msg>>,
     ) {
         if let Some(what) = did.into_past {
             self.fault
@@ -1127,9 +1127,9 @@ impl<M: Model> Worker<M> {
         cs.batches += 1;
         cs.delivered += did.delivered as u64;
         cs.cancels += did.cancelled.len() as u64;
-        let lp = &mut self.lps[li];
         for p in sent.drain(..) {
-            cs.count(model.kind(&p.env.msg));
+            self.committed_stats.count(model.kind(&p.env.msg));
+            let lp = &mut self.lps[li];
             let uid = lp.next_uid();
             // every send comes after this batch: a later one may still cancel it
             if p.retractable {
@@ -1142,14 +1142,15 @@ impl<M: Model> Worker<M> {
                 };
                 lp.sends.insert(s.seq, s);
             }
-            ops.push(Op::Msg { uid, p });
+            self.send(uid, p);
         }
+        let lp = &mut self.lps[li];
         for h in did.cancelled {
             // a committed cancellation is final: its message needs no name any more
             if let Some(s) = lp.sends.remove(&h.seq) {
                 // after this batch in the sequential order: not delivered yet
                 if (&s.time, s.to) > (&did.time, lp.id) {
-                    ops.push(Op::Retract {
+                    retracts.push(Op::Retract {
                         uid: s.uid,
                         to: s.to,
                         time: s.time,
@@ -1169,6 +1170,9 @@ impl<M: Model> Worker<M> {
         }
         let gvt = self.gvt;
         self.lps[li].sweep_sends(&gvt);
+        for op in retracts.drain(..) {
+            self.route(op);
+        }
     }
 
     /// Sends a message a batch (or `init`) of this worker has just made. On this worker it goes
