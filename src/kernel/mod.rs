@@ -81,15 +81,38 @@ impl Ord for VTime {
     }
 }
 
-/// Names a sent message so that its sender can cancel it: the sender and its send sequence.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
-)]
+/// Names a sent message so that its sender can cancel it: the sender and its send sequence,
+/// which alone tell handles apart, and what an optimistic executor needs to reach the message
+/// (its receiver, its simulation time, its transport name), so that no executor has to keep a
+/// record of every send for the cancellations that may come.
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Handle {
     /// The sending object.
     pub from: u32,
+    /// The receiving object.
+    pub to: u32,
     /// The sender's sequence number of the send.
     pub seq: u64,
+    /// Time Warp's transport name of the message (0 under the sequential executor, and for a
+    /// send into the past that was dropped).
+    pub uid: u64,
+    /// The message's simulation time.
+    pub t: f64,
+}
+
+impl PartialEq for Handle {
+    fn eq(&self, o: &Self) -> bool {
+        (self.from, self.seq) == (o.from, o.seq)
+    }
+}
+
+impl Eq for Handle {}
+
+impl std::hash::Hash for Handle {
+    fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
+        self.from.hash(h);
+        self.seq.hash(h);
+    }
 }
 
 /// A message as delivered: its payload, its sender and its name.
@@ -163,13 +186,22 @@ impl<M> Pending<M> {
             .then(self.env.seq.cmp(&o.env.seq))
     }
 
-    /// This message's handle.
+    /// This message's handle (with no transport name).
     pub fn handle(&self) -> Handle {
         Handle {
             from: self.env.from,
+            to: self.to,
             seq: self.env.seq,
+            uid: 0,
+            t: self.time.t(),
         }
     }
+}
+
+/// The transport name of the `n`-th message object `from` sent (counting from 1, rolled-back
+/// sends included), unique over a run.
+pub fn uid(from: u32, n: u64) -> u64 {
+    (u64::from(from) << 40) | n
 }
 
 /// What one batch did, handed back to the executor: messages sent, sends retracted, output.
@@ -178,6 +210,8 @@ pub struct Ctx<'a, M: Model + ?Sized> {
     now: VTime,
     me: u32,
     seq: &'a mut u64,
+    /// The object's count of named messages, when the executor names them (Time Warp).
+    uids: Option<&'a mut u64>,
     /// Messages sent by this batch.
     pub sent: Vec<Pending<M::Msg>>,
     /// Handles this batch cancelled.
@@ -198,6 +232,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             now,
             me,
             seq,
+            uids: None,
             sent: Vec::new(),
             cancelled: Vec::new(),
             output: Vec::new(),
@@ -214,6 +249,14 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             speculative: true,
             ..Ctx::new(model, now, me, seq)
         }
+    }
+
+    /// Names every message this context sends, counting with the object's `uids`: the k-th
+    /// message of the batch gets [`uid`]`(me, count before the batch + k)`, and its handle
+    /// carries the name.
+    pub fn named(mut self, uids: &'a mut u64) -> Ctx<'a, M> {
+        self.uids = Some(uids);
+        self
     }
 
     /// The virtual time of the batch being handled.
@@ -246,34 +289,39 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     }
 
     fn post(&mut self, to: u32, time: VTime, msg: M::Msg, retractable: bool) -> Handle {
+        *self.seq += 1;
+        let mut h = Handle {
+            from: self.me,
+            to,
+            seq: *self.seq,
+            uid: 0,
+            t: time.t(),
+        };
         if time <= self.now {
             let what = format!(
                 "object {} sent a message into the past: {:?} at {:?}",
                 self.me, time, self.now
             );
             assert!(self.speculative, "{what}");
-            *self.seq += 1;
             self.into_past.get_or_insert(what);
-            return Handle {
-                from: self.me,
-                seq: *self.seq,
-            };
+            return h;
         }
-        *self.seq += 1;
+        if let Some(n) = self.uids.as_deref_mut() {
+            *n += 1;
+            h.uid = uid(self.me, *n);
+        }
         let env = Envelope {
             from: self.me,
-            seq: *self.seq,
+            seq: h.seq,
             msg,
         };
-        let p = Pending {
+        self.sent.push(Pending {
             time,
             to,
             priority: self.model.priority(&env.msg),
             retractable,
             env,
-        };
-        let h = p.handle();
-        self.sent.push(p);
+        });
         h
     }
 

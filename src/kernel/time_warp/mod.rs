@@ -63,11 +63,10 @@ pub use floor::Floor;
 use marks::{Mark, Marks};
 
 use super::queue::Queue;
-use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
+use super::{uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
 use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rustc_hash::FxHashMap;
 use std::cmp::Ordering;
 use std::collections::VecDeque;
 
@@ -203,29 +202,28 @@ pub enum Op<Msg> {
         /// Its time.
         time: VTime,
     },
-    /// A model cancellation of `uid` (`sign` 1) or the undoing of one (`sign` -1).
+    /// A model cancellation (`sign` 1) or the undoing of one (`sign` -1), by the batch of
+    /// object `by` at `at`. It can change only batches after that one, which is all the place
+    /// it needs: the message's own place is later still.
     Cancel {
         /// The cancelled message.
-        uid: u64,
-        /// Its receiver.
-        to: u32,
-        /// Its time.
-        time: VTime,
+        h: Handle,
+        /// The time of the cancelling batch.
+        at: VTime,
+        /// The cancelling object.
+        by: u32,
         /// 1 to cancel, -1 to undo.
         sign: i8,
-        /// The simulation time of the cancelling batch: once GVT passes it, the cancellation
-        /// is final.
-        at: f64,
     },
-    /// A model cancellation of `uid` by a batch that ran as final: it can never be undone, so
-    /// the message is gone for good, as an anti-message makes it.
+    /// A model cancellation by a batch that ran as final: it can never be undone, so the
+    /// message is gone for good, as an anti-message makes it.
     Retract {
         /// The cancelled message.
-        uid: u64,
-        /// Its receiver.
-        to: u32,
-        /// Its time.
-        time: VTime,
+        h: Handle,
+        /// The time of the cancelling batch.
+        at: VTime,
+        /// The cancelling object.
+        by: u32,
     },
 }
 
@@ -234,16 +232,25 @@ impl<Msg> Op<Msg> {
     pub fn to(&self) -> u32 {
         match self {
             Op::Msg { p, .. } => p.to,
-            Op::Anti { to, .. } | Op::Cancel { to, .. } | Op::Retract { to, .. } => *to,
+            Op::Anti { to, .. } => *to,
+            Op::Cancel { h, .. } | Op::Retract { h, .. } => h.to,
         }
     }
 
-    /// The virtual time the op affects.
-    pub fn time(&self) -> &VTime {
+    /// The first batch the op may change, as a virtual time and an object: the message's own
+    /// place, or the place just after the batch that cancelled it.
+    pub fn place(&self) -> (&VTime, u32) {
         match self {
-            Op::Msg { p, .. } => &p.time,
-            Op::Anti { time, .. } | Op::Cancel { time, .. } | Op::Retract { time, .. } => time,
+            Op::Msg { p, .. } => (&p.time, p.to),
+            Op::Anti { time, to, .. } => (time, *to),
+            Op::Cancel { at, by, .. } | Op::Retract { at, by, .. } => (at, by + 1),
         }
+    }
+
+    /// [`Op::place`] as a floor.
+    pub fn floor(&self) -> Floor {
+        let (time, to) = self.place();
+        Floor::of(time, to)
     }
 }
 
@@ -388,14 +395,11 @@ impl<Msg> Ord for Item<Msg> {
     }
 }
 
-/// A message an object sent, as its sender remembers it.
+/// A message an uncommitted batch sent, as its sender remembers it to annul it.
 #[derive(Clone, Debug)]
 struct Sent {
     uid: u64,
-    seq: u64,
     to: u32,
-    /// Whether its sender may cancel it: only those are filed once committed.
-    retractable: bool,
     time: VTime,
 }
 
@@ -438,6 +442,23 @@ fn take<T>(pool: &mut Vec<Vec<T>>) -> Vec<T> {
     pool.pop().unwrap_or_default()
 }
 
+/// Whether the message of `h` is still to come after the batch at `time` that cancels it:
+/// sent (not dropped as a send into the past) and not before that batch's instant. A model
+/// cancels only messages still to come, so a message of the same instant is taken to be.
+fn still_to_come(h: &Handle, time: &VTime) -> bool {
+    h.uid != 0 && h.t >= time.t()
+}
+
+/// A time no later than the message of `h`, cancelled by a batch at `at`: the start of the
+/// message's instant, or `at` within it (a handle keeps only the simulation time).
+fn not_before(h: &Handle, at: VTime) -> VTime {
+    if h.t > at.t() {
+        VTime::at(Key::start(h.t))
+    } else {
+        at
+    }
+}
+
 /// Keeps `v`, emptied, for another batch.
 fn give<T>(pool: &mut Vec<Vec<T>>, mut v: Vec<T>) {
     if pool.len() < SPARE && v.capacity() > 0 {
@@ -456,7 +477,8 @@ struct Done<M: Model> {
     inputs: Vec<Input>,
     batch: Vec<Envelope<M::Msg>>,
     sent: Vec<(Sent, u16)>,
-    cancels: Vec<Sent>,
+    /// The messages it cancelled that were still to come.
+    cancels: Vec<Handle>,
     cancel_calls: u32,
     output: Vec<M::Output>,
     /// A send into the past it tried: harmless if rolled back, a model bug if committed.
@@ -466,6 +488,8 @@ struct Done<M: Model> {
 /// What a batch run as final did, for [`Worker::commit_final`].
 struct Did<'a, M: Model> {
     time: VTime,
+    /// The object's count of named messages before it.
+    uids: u64,
     /// Messages it handled.
     delivered: usize,
     cancelled: &'a [Handle],
@@ -480,12 +504,6 @@ struct Lp<M: Model> {
     seq: u64,
     uids: u64,
     history: VecDeque<Done<M>>,
-    /// Messages its committed batches sent that may still be cancelled, by send sequence
-    /// (an uncommitted batch keeps its own in `history`: most are delivered before it commits,
-    /// and never need filing).
-    sends: FxHashMap<u64, Sent>,
-    /// Size of `sends` past which fossil collection sweeps it (amortized: doubled each sweep).
-    sweep_at: usize,
     /// Whether it is in its worker's list of objects with uncommitted batches.
     active: bool,
 }
@@ -493,33 +511,6 @@ struct Lp<M: Model> {
 impl<M: Model> Lp<M> {
     fn last_time(&self) -> Option<&VTime> {
         self.history.back().map(|d| &d.time)
-    }
-
-    /// The message it sent with sequence `seq`, if it may still be cancelled.
-    fn sent(&self, seq: u64) -> Option<&Sent> {
-        // batches in history are in send order: the last one that began before `seq` sent it
-        let k = self.history.partition_point(|d| d.pre_seq < seq);
-        if k == 0 {
-            return self.sends.get(&seq);
-        }
-        let sent = &self.history[k - 1].sent;
-        sent.binary_search_by_key(&seq, |(s, _)| s.seq)
-            .ok()
-            .map(|i| &sent[i].0)
-    }
-
-    /// Forgets filed sends that GVT passed (delivered: cancelling them does nothing), once
-    /// there are many (amortized: the threshold doubles with what is left).
-    fn sweep_sends(&mut self, gvt: &Floor) {
-        if self.sends.len() > self.sweep_at {
-            self.sends.retain(|_, s| !gvt.passed(&s.time, s.to));
-            self.sweep_at = 2 * self.sends.len().max(32);
-        }
-    }
-
-    fn next_uid(&mut self) -> u64 {
-        self.uids += 1;
-        (u64::from(self.id) << 40) | self.uids
     }
 }
 
@@ -655,8 +646,6 @@ impl<M: Model> Worker<M> {
                     seq: 0,
                     uids: 0,
                     history: VecDeque::new(),
-                    sends: FxHashMap::default(),
-                    sweep_at: 64,
                     active: false,
                 })
                 .collect(),
@@ -705,27 +694,14 @@ impl<M: Model> Worker<M> {
     pub fn init(&mut self, model: &M, start: &VTime) {
         for k in 0..self.lps.len() {
             let lp = &mut self.lps[k];
-            let mut ctx = Ctx::new(model, start.clone(), lp.id, &mut lp.seq);
-            model.init(&mut ctx, lp.id, &mut lp.state);
+            let (id, first) = (lp.id, lp.uids);
+            let mut ctx = Ctx::new(model, start.clone(), id, &mut lp.seq).named(&mut lp.uids);
+            model.init(&mut ctx, id, &mut lp.state);
             let sent = ctx.sent;
             assert!(ctx.cancelled.is_empty(), "init may not cancel");
-            for p in sent {
+            for (n, p) in (first + 1..).zip(sent) {
                 self.committed_stats.count(model.kind(&p.env.msg));
-                let lp = &mut self.lps[k];
-                let uid = lp.next_uid();
-                if p.retractable {
-                    lp.sends.insert(
-                        p.env.seq,
-                        Sent {
-                            uid,
-                            seq: p.env.seq,
-                            to: p.to,
-                            retractable: true,
-                            time: p.time.clone(),
-                        },
-                    );
-                }
-                self.send(uid, p);
+                self.send(uid(id, n), p);
             }
         }
         self.drain_local();
@@ -773,7 +749,7 @@ impl<M: Model> Worker<M> {
         if w == self.index {
             self.local_ops.push(op);
         } else {
-            let f = Floor::of(op.time(), op.to());
+            let f = op.floor();
             self.outbox_floor = self.outbox_floor.min(f);
             self.final_bound = self.final_bound.min(f);
             self.outbox[w].push(op);
@@ -789,8 +765,8 @@ impl<M: Model> Worker<M> {
     /// Applies one op, rolling its receiver back if the op changes what the receiver's past
     /// should have seen.
     fn apply(&mut self, op: Op<M::Msg>) {
-        let (to, time) = (op.to(), op.time());
-        if self.final_floor.reaches(time, to) {
+        let (to, (time, from)) = (op.to(), op.place());
+        if self.final_floor.reaches(time, from) {
             self.fault.get_or_insert(format!(
                 "time warp: an op for object {to} at t = {} came after a later batch ran as final",
                 time.t()
@@ -818,26 +794,22 @@ impl<M: Model> Worker<M> {
                     self.undo_handling(li, &time);
                 }
             }
-            Op::Retract { uid, time, .. } => {
-                let unseen = self.marks.cancelled(uid);
-                if !self.marks.retract(uid) && !unseen {
-                    self.undo_handling(li, &time);
+            // the canceller itself never handled its message, which comes after the batch that
+            // cancels it
+            Op::Retract { h, at, by } => {
+                let unseen = self.marks.cancelled(h.uid);
+                if !self.marks.retract(h.uid) && !unseen && h.to != by {
+                    self.undo_handling(li, &not_before(&h, at));
                 }
             }
-            Op::Cancel {
-                uid,
-                time,
-                sign,
-                at,
-                ..
-            } => {
-                let before = self.marks.cancelled(uid);
-                let back = self.marks.cancel(uid, time.t(), at, sign);
-                if before != self.marks.cancelled(uid) && self.ran_past(li, &time) {
-                    self.rollback(li, &time);
+            Op::Cancel { h, at, by, sign } => {
+                let before = self.marks.cancelled(h.uid);
+                let back = self.marks.cancel(h.uid, h.t, at.t(), sign);
+                if before != self.marks.cancelled(h.uid) && h.to != by {
+                    self.undo_handling(li, &not_before(&h, at));
                 }
                 if let Some(p) = back {
-                    self.push(Item { uid, p });
+                    self.push(Item { uid: h.uid, p });
                 }
             }
         }
@@ -884,13 +856,12 @@ impl<M: Model> Worker<M> {
             give(&mut self.spare.inputs, inputs);
             give(&mut self.spare.batches, batch);
             give(&mut self.spare.sent, sent);
-            for c in d.cancels {
+            for h in d.cancels {
                 let op = Op::Cancel {
-                    uid: c.uid,
-                    to: c.to,
-                    time: c.time,
+                    h,
+                    at: d.time.clone(),
+                    by: to,
                     sign: -1,
-                    at: d.time.t(),
                 };
                 self.route(op);
             }
@@ -926,7 +897,7 @@ impl<M: Model> Worker<M> {
             let mut b = peers.min(self.outbox_floor);
             if let Some(c) = &self.chaos {
                 for (_, op) in &c.held {
-                    b = b.min(Floor::of(op.time(), op.to()));
+                    b = b.min(op.floor());
                 }
             }
             self.final_bound = b;
@@ -1013,8 +984,8 @@ impl<M: Model> Worker<M> {
             ));
         }
         let pre_state = (!run_final).then(|| lp.state.clone());
-        let pre_seq = lp.seq;
-        let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq);
+        let (pre_seq, first) = (lp.seq, lp.uids);
+        let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq).named(&mut lp.uids);
         ctx.sent = std::mem::take(&mut self.spare.pending);
         model.handle(&mut ctx, to, &mut lp.state, &batch);
         let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
@@ -1028,6 +999,7 @@ impl<M: Model> Worker<M> {
             give(&mut self.spare.batches, batch);
             let did = Did {
                 time,
+                uids: first,
                 delivered,
                 cancelled: &cancelled,
                 output,
@@ -1036,40 +1008,27 @@ impl<M: Model> Worker<M> {
             self.commit_final(model, li, did, &mut sent, &mut ops);
         } else {
             let mut sent_recs = take(&mut self.spare.sent);
-            for p in sent.drain(..) {
-                let uid = lp.next_uid();
+            for (n, p) in (first + 1..).zip(sent.drain(..)) {
+                let uid = uid(to, n);
                 let s = Sent {
                     uid,
-                    seq: p.env.seq,
                     to: p.to,
-                    retractable: p.retractable,
                     time: p.time.clone(),
                 };
                 sent_recs.push((s, model.kind(&p.env.msg) as u16));
                 ops.push(Op::Msg { uid, p });
             }
-            let mut cancels = Vec::new();
-            for h in &cancelled {
-                let this_batch = sent_recs.binary_search_by_key(&h.seq, |(s, _)| s.seq);
-                let s = match this_batch {
-                    Ok(i) => Some(&sent_recs[i].0),
-                    Err(_) => lp.sent(h.seq),
-                };
-                if let Some(s) = s {
-                    // after this batch in the sequential order: not delivered yet
-                    if (&s.time, s.to) > (&time, to) {
-                        cancels.push(s.clone());
-                    }
-                }
-            }
-            for c in &cancels {
-                // the cancelled message's receiver and time, not this batch's
+            let cancels: Vec<Handle> = cancelled
+                .iter()
+                .filter(|h| still_to_come(h, &time))
+                .copied()
+                .collect();
+            for &h in &cancels {
                 ops.push(Op::Cancel {
-                    uid: c.uid,
-                    to: c.to,
-                    time: c.time.clone(),
+                    h,
+                    at: time.clone(),
+                    by: to,
                     sign: 1,
-                    at: time.t(),
                 });
             }
             if !lp.active {
@@ -1107,9 +1066,9 @@ impl<M: Model> Worker<M> {
         true
     }
 
-    /// Commits a batch that ran as final at once, keeping no record of it: counts it, files
-    /// its sends that a later batch may still cancel, sends them, and turns its cancellations
-    /// into retractions (collected in `retracts`, emptied).
+    /// Commits a batch that ran as final at once, keeping no record of it: counts it, sends
+    /// its messages, and turns its cancellations into retractions (collected in `retracts`,
+    /// emptied).
     fn commit_final(
         &mut self,
         model: &M,
@@ -1127,38 +1086,20 @@ impl<M: Model> Worker<M> {
         cs.batches += 1;
         cs.delivered += did.delivered as u64;
         cs.cancels += did.cancelled.len() as u64;
-        for p in sent.drain(..) {
+        let id = self.lps[li].id;
+        for (n, p) in (did.uids + 1..).zip(sent.drain(..)) {
             self.committed_stats.count(model.kind(&p.env.msg));
-            let lp = &mut self.lps[li];
-            let uid = lp.next_uid();
-            // every send comes after this batch: a later one may still cancel it
-            if p.retractable {
-                let s = Sent {
-                    uid,
-                    seq: p.env.seq,
-                    to: p.to,
-                    retractable: true,
-                    time: p.time.clone(),
-                };
-                lp.sends.insert(s.seq, s);
-            }
-            self.send(uid, p);
+            self.send(uid(id, n), p);
         }
-        let lp = &mut self.lps[li];
-        for h in did.cancelled {
-            // a committed cancellation is final: its message needs no name any more
-            if let Some(s) = lp.sends.remove(&h.seq) {
-                // after this batch in the sequential order: not delivered yet
-                if (&s.time, s.to) > (&did.time, lp.id) {
-                    retracts.push(Op::Retract {
-                        uid: s.uid,
-                        to: s.to,
-                        time: s.time,
-                    });
-                }
-            }
+        // a committed cancellation is final
+        for h in did.cancelled.iter().filter(|h| still_to_come(h, &did.time)) {
+            retracts.push(Op::Retract {
+                h: *h,
+                at: did.time.clone(),
+                by: id,
+            });
         }
-        let id = lp.id;
+        let lp = &self.lps[li];
         let state = (self.ship && model.observed(id)).then(|| lp.state.clone());
         if state.is_some() || !did.output.is_empty() {
             self.to_ship.push(Committed {
@@ -1168,8 +1109,6 @@ impl<M: Model> Worker<M> {
                 output: did.output,
             });
         }
-        let gvt = self.gvt;
-        self.lps[li].sweep_sends(&gvt);
         for op in retracts.drain(..) {
             self.route(op);
         }
@@ -1288,12 +1227,9 @@ impl<M: Model> Worker<M> {
         };
         if let Some(c) = &self.chaos {
             for (_, op) in &c.held {
-                m = m.min(Floor::of(op.time(), op.to()));
-                // a held cancellation keeps GVT below its batch, so that fossil collection
-                // cannot take the message it counts on for cancelled for good
-                if let Op::Cancel { at, .. } = op {
-                    m = m.min(Floor::start(*at));
-                }
+                // a held cancellation keeps GVT below its batch (its floor), so that fossil
+                // collection cannot take the message it counts on for cancelled for good
+                m = m.min(op.floor());
             }
         }
         m
@@ -1324,29 +1260,20 @@ impl<M: Model> Worker<M> {
     /// Commits one batch of local object `li`: counts it, files the sends a later batch may
     /// still cancel (those `floor` has not passed), frees its input records, and keeps for the
     /// collector what its sinks see (`state` is the object's state after it, when observed).
-    fn commit(&mut self, li: usize, mut d: Done<M>, state: Option<M::State>, floor: &Floor) {
+    fn commit(&mut self, li: usize, mut d: Done<M>, state: Option<M::State>) {
         if let Some(what) = d.into_past {
             self.fault
                 .get_or_insert(format!("model bug in a committed batch: {what}"));
         }
         self.stats.committed += 1;
-        let lp = &mut self.lps[li];
         let cs = &mut self.committed_stats;
         cs.batches += 1;
         cs.delivered += d.batch.len() as u64;
         cs.cancels += u64::from(d.cancel_calls);
-        for (s, kind) in d.sent.drain(..) {
+        for (_, kind) in d.sent.drain(..) {
             cs.count(usize::from(kind));
-            // still ahead: it may yet be cancelled by a later batch
-            if s.retractable && !floor.passed(&s.time, s.to) {
-                lp.sends.insert(s.seq, s);
-            }
         }
-        // a committed cancellation is final: its message needs no name any more
-        for c in &d.cancels {
-            lp.sends.remove(&c.seq);
-        }
-        let id = lp.id;
+        let id = self.lps[li].id;
         give(&mut self.spare.sent, d.sent);
         give(&mut self.spare.inputs, d.inputs);
         give(&mut self.spare.batches, d.batch);
@@ -1382,7 +1309,7 @@ impl<M: Model> Worker<M> {
                 None => lp.state.clone(),
             });
             self.uncommitted -= 1;
-            self.commit(li, d, state, floor);
+            self.commit(li, d, state);
         }
     }
 
@@ -1418,7 +1345,6 @@ impl<M: Model> Worker<M> {
             let li = self.active[k] as usize;
             self.commit_front(model, li, &gvt);
             let lp = &mut self.lps[li];
-            lp.sweep_sends(&gvt);
             if lp.history.is_empty() {
                 lp.active = false;
             } else {

@@ -105,10 +105,7 @@ where
     M::Output: Send,
 {
     fn send(&self, _from: usize, to: usize, mut ops: Vec<Op<M::Msg>>) {
-        let floor = ops
-            .iter()
-            .map(|op| Floor::of(op.time(), op.to()))
-            .fold(Floor::INFINITY, Floor::min);
+        let floor = ops.iter().map(Op::floor).fold(Floor::INFINITY, Floor::min);
         let mut slot = self.slots[to].lock().expect("no thread panicked");
         let slot = &mut *slot;
         if slot.inbox.is_empty() {
