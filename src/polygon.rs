@@ -1109,6 +1109,15 @@ mod tests {
     }
 
     #[test]
+    fn grids_of_any_size_are_valid_layouts() {
+        // the sectored engines take a grid without validating it
+        let (lo, hi) = (v(-3.7, 1.1), v(1234.567, 890.123));
+        for (nx, ny) in [(1, 1), (7, 5), (113, 109)] {
+            validate_layout(&grid(lo, hi, nx, ny), lo, hi).unwrap();
+        }
+    }
+
+    #[test]
     fn adjacency_of_a_grid() {
         let g = grid(v(0.0, 0.0), v(3.0, 3.0), 3, 3);
         let adj = adjacency(&g, 0.0);
