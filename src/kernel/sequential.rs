@@ -2,6 +2,7 @@
 
 use super::queue::Queue;
 use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
+use crate::engine::prefetch::{prefetch, prefetch_all};
 use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
 
@@ -153,6 +154,12 @@ impl<M: Model> Sequential<M> {
                     break;
                 }
                 batch.push(p.env);
+            }
+            // the next batch's object, most likely: its state loads while this batch runs
+            if let Some(Item(next)) = self.pending.peek() {
+                let o = next.to as usize;
+                prefetch_all(&self.states[o]);
+                prefetch(&self.seqs[o]);
             }
             self.stats.batches += 1;
             self.stats.delivered += batch.len() as u64;

@@ -64,6 +64,7 @@ use marks::{Mark, Marks};
 
 use super::queue::Queue;
 use super::{uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
+use crate::engine::prefetch::prefetch_all;
 use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -971,6 +972,10 @@ impl<M: Model> Worker<M> {
                 }
                 mark => self.marks.set_aside(it.uid, it.p, mark),
             }
+        }
+        // the next batch's object, most likely: its record loads while this batch runs
+        if let Some(next) = self.heap.peek() {
+            prefetch_all(&self.lps[self.placement.local(next.p.to)]);
         }
         let lp = &mut self.lps[li];
         // GVT cannot pass an instant this deep, so it would pile up batches until memory ran
