@@ -1082,15 +1082,7 @@ impl<M: Model> Worker<M> {
         sent: &mut Vec<Pending<M::Msg>>,
         retracts: &mut Vec<Op<M::Msg>>,
     ) {
-        if let Some(what) = did.into_past {
-            self.fault
-                .get_or_insert(format!("model bug in a committed batch: {what}"));
-        }
-        self.stats.committed += 1;
-        let cs = &mut self.committed_stats;
-        cs.batches += 1;
-        cs.delivered += did.delivered as u64;
-        cs.cancels += did.cancelled.len() as u64;
+        self.count_committed(did.into_past, did.delivered, did.cancelled.len());
         let id = self.lps[li].id;
         for (n, p) in (did.uids + 1..).zip(sent.drain(..)) {
             self.committed_stats.count(model.kind(&p.env.msg));
@@ -1104,16 +1096,8 @@ impl<M: Model> Worker<M> {
                 by: id,
             });
         }
-        let lp = &self.lps[li];
-        let state = (self.ship && model.observed(id)).then(|| lp.state.clone());
-        if state.is_some() || !did.output.is_empty() {
-            self.to_ship.push(Committed {
-                time: did.time,
-                obj: id,
-                state,
-                output: did.output,
-            });
-        }
+        let state = (self.ship && model.observed(id)).then(|| self.lps[li].state.clone());
+        self.keep_for_collector(did.time, id, state, did.output);
         for op in retracts.drain(..) {
             self.route(op);
         }
@@ -1262,33 +1246,49 @@ impl<M: Model> Worker<M> {
         }
     }
 
-    /// Commits one batch of local object `li`: counts it, files the sends a later batch may
-    /// still cancel (those `floor` has not passed), frees its input records, and keeps for the
-    /// collector what its sinks see (`state` is the object's state after it, when observed).
+    /// Commits one optimistic batch of local object `li`: counts it and its sends, frees its
+    /// records, and keeps for the collector what its sinks see (`state` is the object's state
+    /// after it, when observed).
     fn commit(&mut self, li: usize, mut d: Done<M>, state: Option<M::State>) {
-        if let Some(what) = d.into_past {
+        self.count_committed(d.into_past.take(), d.batch.len(), d.cancel_calls as usize);
+        for (_, kind) in d.sent.drain(..) {
+            self.committed_stats.count(usize::from(kind));
+        }
+        give(&mut self.spare.sent, d.sent);
+        give(&mut self.spare.inputs, d.inputs);
+        give(&mut self.spare.batches, d.batch);
+        self.keep_for_collector(d.time, self.lps[li].id, state, d.output);
+    }
+
+    /// Counts a committed batch that handled `delivered` messages and made `cancels`
+    /// cancellations; a send into the past it tried is now a model bug.
+    fn count_committed(&mut self, into_past: Option<String>, delivered: usize, cancels: usize) {
+        if let Some(what) = into_past {
             self.fault
                 .get_or_insert(format!("model bug in a committed batch: {what}"));
         }
         self.stats.committed += 1;
         let cs = &mut self.committed_stats;
         cs.batches += 1;
-        cs.delivered += d.batch.len() as u64;
-        cs.cancels += u64::from(d.cancel_calls);
-        for (_, kind) in d.sent.drain(..) {
-            cs.count(usize::from(kind));
-        }
-        let id = self.lps[li].id;
-        give(&mut self.spare.sent, d.sent);
-        give(&mut self.spare.inputs, d.inputs);
-        give(&mut self.spare.batches, d.batch);
-        // the collector needs only what its sinks see
-        if state.is_some() || !d.output.is_empty() {
+        cs.delivered += delivered as u64;
+        cs.cancels += cancels as u64;
+    }
+
+    /// Keeps what the collector needs of a committed batch of object `obj`: only what its
+    /// sinks see.
+    fn keep_for_collector(
+        &mut self,
+        time: VTime,
+        obj: u32,
+        state: Option<M::State>,
+        output: Vec<M::Output>,
+    ) {
+        if state.is_some() || !output.is_empty() {
             self.to_ship.push(Committed {
-                time: d.time,
-                obj: id,
+                time,
+                obj,
                 state,
-                output: d.output,
+                output,
             });
         }
     }
