@@ -54,20 +54,82 @@ impl ThreadReduce {
 
 /// A worker's inbox and what bounds it.
 struct Slot<Msg> {
-    /// Ops sent to it, not taken yet.
-    inbox: Vec<Op<Msg>>,
-    /// Below every op in the inbox.
-    inbox_floor: Floor,
-    /// Below everything the worker holds or has yet to send: its published floor, lowered to
-    /// the inbox's when it takes the inbox.
-    floor: Floor,
-    /// Changes so far: a reading of every slot saw one instant if no count moved while it read.
-    version: u64,
+    /// Ops sent to it, not taken yet; whoever changes `floors` holds this lock.
+    inbox: Mutex<Vec<Op<Msg>>>,
+    /// Its floors, readable without the lock.
+    floors: Floors,
+}
+
+/// Words of one floor.
+const WORDS: usize = super::floor::DEPTH + 3;
+
+/// A worker's two floors behind a sequence lock, so that the other workers read them without
+/// taking its lock: the inbox's floor, below every op in the inbox, and the worker's own, below
+/// everything it holds or has yet to send (its published floor, lowered to the inbox's when it
+/// takes the inbox). One writer at a time, the holder of the inbox lock.
+struct Floors {
+    /// Twice the changes so far, plus one while a change is being written: a reading of every
+    /// slot saw one instant if no count moved while it read.
+    seq: AtomicU64,
+    /// The worker's floor, then the inbox's, as words.
+    words: [AtomicU64; 2 * WORDS],
+}
+
+impl Floors {
+    fn new(own: Floor, inbox: Floor) -> Floors {
+        let f = Floors {
+            seq: AtomicU64::new(0),
+            words: std::array::from_fn(|_| AtomicU64::new(0)),
+        };
+        f.write(own, inbox);
+        f
+    }
+
+    /// Sets both floors; the caller holds the slot's inbox lock.
+    fn write(&self, own: Floor, inbox: Floor) {
+        let s = self.seq.load(Ordering::Relaxed);
+        self.seq.store(s + 1, Ordering::Relaxed);
+        std::sync::atomic::fence(Ordering::Release);
+        for (w, v) in self
+            .words
+            .iter()
+            .zip(own.to_words().into_iter().chain(inbox.to_words()))
+        {
+            w.store(v, Ordering::Relaxed);
+        }
+        self.seq.store(s + 2, Ordering::Release);
+    }
+
+    /// Both floors, as the holder of the inbox lock (the only writer) reads them.
+    fn current(&self) -> (Floor, Floor) {
+        let w: [u64; 2 * WORDS] = std::array::from_fn(|i| self.words[i].load(Ordering::Relaxed));
+        (
+            Floor::from_words(&w[..WORDS]),
+            Floor::from_words(&w[WORDS..]),
+        )
+    }
+
+    /// The change count and both floors, or `None` if a change was being written meanwhile.
+    fn read(&self) -> Option<(u64, Floor, Floor)> {
+        let s = self.seq.load(Ordering::Acquire);
+        if s % 2 == 1 {
+            return None;
+        }
+        let w: [u64; 2 * WORDS] = std::array::from_fn(|i| self.words[i].load(Ordering::Relaxed));
+        std::sync::atomic::fence(Ordering::Acquire);
+        (self.seq.load(Ordering::Relaxed) == s).then(|| {
+            let (own, inbox) = (
+                Floor::from_words(&w[..WORDS]),
+                Floor::from_words(&w[WORDS..]),
+            );
+            (s, own, inbox)
+        })
+    }
 }
 
 /// Workers as threads of this process.
 pub struct ThreadFabric<M: Model> {
-    slots: Vec<Mutex<Slot<M::Msg>>>,
+    slots: Vec<Slot<M::Msg>>,
     reduce: ThreadReduce,
     /// GVT rounds asked for so far (by any worker): every worker with fewer behind it starts one.
     rounds_asked: AtomicU64,
@@ -82,13 +144,9 @@ where
     pub fn new(n: usize, collector: mpsc::Sender<Chunk<M::State, M::Output>>) -> Self {
         ThreadFabric {
             slots: (0..n)
-                .map(|_| {
-                    Mutex::new(Slot {
-                        inbox: Vec::new(),
-                        inbox_floor: Floor::INFINITY,
-                        floor: Floor::NEG_INFINITY,
-                        version: 0,
-                    })
+                .map(|_| Slot {
+                    inbox: Mutex::new(Vec::new()),
+                    floors: Floors::new(Floor::NEG_INFINITY, Floor::INFINITY),
                 })
                 .collect(),
             reduce: ThreadReduce::new(n),
@@ -106,31 +164,30 @@ where
 {
     fn send(&self, _from: usize, to: usize, mut ops: Vec<Op<M::Msg>>) {
         let floor = ops.iter().map(Op::floor).fold(Floor::INFINITY, Floor::min);
-        let mut slot = self.slots[to].lock().expect("no thread panicked");
-        let slot = &mut *slot;
-        if slot.inbox.is_empty() {
-            std::mem::swap(&mut slot.inbox, &mut ops);
+        let slot = &self.slots[to];
+        let mut inbox = slot.inbox.lock().expect("no thread panicked");
+        if inbox.is_empty() {
+            std::mem::swap(&mut *inbox, &mut ops);
         } else {
-            slot.inbox.append(&mut ops);
+            inbox.append(&mut ops);
         }
-        slot.inbox_floor = slot.inbox_floor.min(floor);
-        slot.version += 1;
+        let (own, waiting) = slot.floors.current();
+        slot.floors.write(own, waiting.min(floor));
     }
 
     fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
-        let mut slot = self.slots[me].lock().expect("no thread panicked");
-        let slot = &mut *slot;
-        if slot.inbox.is_empty() {
+        let slot = &self.slots[me];
+        let mut inbox = slot.inbox.lock().expect("no thread panicked");
+        if inbox.is_empty() {
             return;
         }
         if into.is_empty() {
-            std::mem::swap(&mut slot.inbox, into);
+            std::mem::swap(&mut *inbox, into);
         } else {
-            into.append(&mut slot.inbox);
+            into.append(&mut inbox);
         }
-        slot.floor = slot.floor.min(slot.inbox_floor);
-        slot.inbox_floor = Floor::INFINITY;
-        slot.version += 1;
+        let (own, waiting) = slot.floors.current();
+        slot.floors.write(own.min(waiting), Floor::INFINITY);
     }
 
     fn reduce(&self, me: usize, local: Reduction) -> Reduction {
@@ -155,31 +212,32 @@ where
     }
 
     fn publish(&self, me: usize, floor: Floor) {
-        let mut slot = self.slots[me].lock().expect("no thread panicked");
-        slot.floor = floor;
-        slot.version += 1;
+        let slot = &self.slots[me];
+        let _inbox = slot.inbox.lock().expect("no thread panicked");
+        let (_, waiting) = slot.floors.current();
+        slot.floors.write(floor, waiting);
     }
 
     fn peers_floor(&self, me: usize) -> Option<Floor> {
         // an op is always under some floor: in its sender's until it is in an inbox, in the
         // inbox's until its receiver takes it, and in its receiver's from then on
-        let (mut versions, mut floor) = (0u64, Floor::INFINITY);
+        let (mut changes, mut floor) = (0u64, Floor::INFINITY);
         for (w, slot) in self.slots.iter().enumerate() {
-            let slot = slot.lock().expect("no thread panicked");
-            versions += slot.version;
-            floor = floor.min(slot.inbox_floor);
+            let (seq, own, waiting) = slot.floors.read()?;
+            changes += seq;
+            floor = floor.min(waiting);
             if w != me {
-                floor = floor.min(slot.floor);
+                floor = floor.min(own);
             }
         }
-        // versions only grow: the same sum on a second reading means no slot changed between
+        // counts only grow: the same sum on a second reading means no slot changed between
         // its two readings, so all of them held at one instant between the two passes
         let again: u64 = self
             .slots
             .iter()
-            .map(|slot| slot.lock().expect("no thread panicked").version)
+            .map(|slot| slot.floors.seq.load(Ordering::Acquire))
             .sum();
-        (again == versions).then_some(floor)
+        (again == changes).then_some(floor)
     }
 }
 
