@@ -199,7 +199,7 @@ impl<M> Pending<M> {
 }
 
 /// The transport name of the `n`-th message object `from` sent (counting from 1, rolled-back
-/// sends included), unique over a run.
+/// sends included, dropped sends into the past not), unique over a run.
 pub fn uid(from: u32, n: u64) -> u64 {
     (u64::from(from) << 40) | n
 }
@@ -253,7 +253,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
 
     /// Names every message this context sends, counting with the object's `uids`: the k-th
     /// message of the batch gets [`uid`]`(me, count before the batch + k)`, and its handle
-    /// carries the name.
+    /// carries the name. A send into the past, dropped, takes no name (its handle's is 0).
     pub fn named(mut self, uids: &'a mut u64) -> Ctx<'a, M> {
         self.uids = Some(uids);
         self
@@ -325,8 +325,10 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
         h
     }
 
-    /// Retracts a message this object sent (one thesis Cancel message). Cancelling a message
-    /// that was already delivered is a model bug the executor reports.
+    /// Retracts a message this object sent (one thesis Cancel message), which must still be to
+    /// come after this batch: the executors do not check that a message was not delivered
+    /// already (Time Warp ignores a message of an earlier instant, and takes one of this
+    /// batch's instant to be still to come).
     pub fn cancel(&mut self, h: Handle) {
         self.cancelled.push(h);
     }

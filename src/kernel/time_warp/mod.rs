@@ -25,9 +25,10 @@
 //! and the sequential executor's cost per message is one heap item too. Every change of
 //! liveness in an object's past rolls the object back to it.
 //!
-//! A model cancellation takes effect only where the sequential executor's would: when the
-//! cancelled message comes after the cancelling batch in the (virtual time, receiver) order of
-//! batches; otherwise it was already delivered and the cancellation does nothing.
+//! A model cancels only messages still to come after the cancelling batch (the kernel's
+//! contract, [`Ctx::cancel`]). A handle keeps the message's simulation time, not its key: a
+//! cancellation of a message of an earlier instant does nothing, and one of the cancelling
+//! batch's own instant is taken at its word.
 //!
 //! A batch that comes before every op any other worker may still send its worker is final
 //! already: it runs without saving its object's state and commits at once (with the object's
@@ -450,11 +451,15 @@ fn still_to_come(h: &Handle, time: &VTime) -> bool {
     h.uid != 0 && h.t >= time.t()
 }
 
-/// A time no later than the message of `h`, cancelled by a batch at `at`: the start of the
-/// message's instant, or `at` within it (a handle keeps only the simulation time).
-fn not_before(h: &Handle, at: VTime) -> VTime {
+/// A time no later than the message of `h`, cancelled by the batch of object `by` at `at`, and
+/// after every batch before that one's place: the start of the message's instant, or within the
+/// cancelling batch's instant the first time its message can have (a handle keeps only the
+/// simulation time). A message to an object below `by` comes at a later time than `at`.
+fn not_before(h: &Handle, at: VTime, by: u32) -> VTime {
     if h.t > at.t() {
         VTime::at(Key::start(h.t))
+    } else if h.to < by {
+        at.next_gen()
     } else {
         at
     }
@@ -471,8 +476,8 @@ fn give<T>(pool: &mut Vec<Vec<T>>, mut v: Vec<T>) {
 /// A batch an object ran that is not committed yet.
 struct Done<M: Model> {
     time: VTime,
-    /// The object's state before it; `None` for a batch run as final.
-    pre_state: Option<M::State>,
+    /// The object's state before it.
+    pre_state: M::State,
     pre_seq: u64,
     /// The messages it handled: their names, and the envelopes the model saw.
     inputs: Vec<Input>,
@@ -766,8 +771,8 @@ impl<M: Model> Worker<M> {
     /// Applies one op, rolling its receiver back if the op changes what the receiver's past
     /// should have seen.
     fn apply(&mut self, op: Op<M::Msg>) {
-        let (to, (time, from)) = (op.to(), op.place());
-        if self.final_floor.reaches(time, from) {
+        let (to, (time, obj)) = (op.to(), op.place());
+        if self.final_floor.reaches(time, obj) {
             self.fault.get_or_insert(format!(
                 "time warp: an op for object {to} at t = {} came after a later batch ran as final",
                 time.t()
@@ -800,14 +805,14 @@ impl<M: Model> Worker<M> {
             Op::Retract { h, at, by } => {
                 let unseen = self.marks.cancelled(h.uid);
                 if !self.marks.retract(h.uid) && !unseen && h.to != by {
-                    self.undo_handling(li, &not_before(&h, at));
+                    self.undo_handling(li, &not_before(&h, at, by));
                 }
             }
             Op::Cancel { h, at, by, sign } => {
                 let before = self.marks.cancelled(h.uid);
                 let back = self.marks.cancel(h.uid, h.t, at.t(), sign);
                 if before != self.marks.cancelled(h.uid) && h.to != by {
-                    self.undo_handling(li, &not_before(&h, at));
+                    self.undo_handling(li, &not_before(&h, at, by));
                 }
                 if let Some(p) = back {
                     self.push(Item { uid: h.uid, p });
@@ -839,7 +844,7 @@ impl<M: Model> Worker<M> {
             let d = lp.history.pop_back().expect("a batch to undo");
             self.uncommitted -= 1;
             self.stats.rolled_back += 1;
-            lp.state = d.pre_state.expect("an uncommitted batch saved its state");
+            lp.state = d.pre_state;
             lp.seq = d.pre_seq;
             let to = lp.id;
             let (mut inputs, mut batch, mut sent) = (d.inputs, d.batch, d.sent);
@@ -950,7 +955,11 @@ impl<M: Model> Worker<M> {
             }
         }
         // a batch run as final is never put back, so it keeps no names of its messages
-        let mut inputs = take(&mut self.spare.inputs);
+        let mut inputs = if run_final {
+            Vec::new()
+        } else {
+            take(&mut self.spare.inputs)
+        };
         let mut batch = take(&mut self.spare.batches);
         let (input, env) = first.into_input();
         if !run_final {
@@ -1000,7 +1009,6 @@ impl<M: Model> Worker<M> {
         if run_final {
             self.stats.final_batches += 1;
             let delivered = batch.len();
-            give(&mut self.spare.inputs, inputs);
             give(&mut self.spare.batches, batch);
             let did = Did {
                 time,
@@ -1045,7 +1053,7 @@ impl<M: Model> Worker<M> {
             }
             lp.history.push_back(Done {
                 time,
-                pre_state,
+                pre_state: pre_state.expect("saved: the batch is not final"),
                 pre_seq,
                 inputs,
                 batch,
@@ -1072,15 +1080,14 @@ impl<M: Model> Worker<M> {
     }
 
     /// Commits a batch that ran as final at once, keeping no record of it: counts it, sends
-    /// its messages, and turns its cancellations into retractions (collected in `retracts`,
-    /// emptied).
+    /// its messages, and turns its cancellations into retractions, pushed to `ops`.
     fn commit_final(
         &mut self,
         model: &M,
         li: usize,
         did: Did<'_, M>,
         sent: &mut Vec<Pending<M::Msg>>,
-        retracts: &mut Vec<Op<M::Msg>>,
+        ops: &mut Vec<Op<M::Msg>>,
     ) {
         self.count_committed(did.into_past, did.delivered, did.cancelled.len());
         let id = self.lps[li].id;
@@ -1090,7 +1097,7 @@ impl<M: Model> Worker<M> {
         }
         // a committed cancellation is final
         for h in did.cancelled.iter().filter(|h| still_to_come(h, &did.time)) {
-            retracts.push(Op::Retract {
+            ops.push(Op::Retract {
                 h: *h,
                 at: did.time.clone(),
                 by: id,
@@ -1098,14 +1105,11 @@ impl<M: Model> Worker<M> {
         }
         let state = (self.ship && model.observed(id)).then(|| self.lps[li].state.clone());
         self.keep_for_collector(did.time, id, state, did.output);
-        for op in retracts.drain(..) {
-            self.route(op);
-        }
     }
 
     /// Sends a message a batch (or `init`) of this worker has just made. On this worker it goes
-    /// straight to the heap: no mark can name it yet, and only an object that ran past it since
-    /// a rollback needs rolling back.
+    /// straight to the heap: no mark can name it yet, and its receiver needs rolling back only
+    /// if it ran ahead of it, which [`Worker::ran_past`] tells at a glance for most messages.
     fn send(&mut self, uid: u64, p: Pending<M::Msg>) {
         self.stats.messages += 1;
         let w = self.placement.worker(p.to);
@@ -1121,6 +1125,14 @@ impl<M: Model> Worker<M> {
         }
         self.push(Item { uid, p });
         self.note_entries();
+    }
+
+    /// With every batch committed, no message can be a straggler: [`Worker::ran_past`] answers
+    /// at once again.
+    fn forget_high(&mut self) {
+        if self.uncommitted == 0 {
+            self.high = None;
+        }
     }
 
     /// Whether local object `li` ran a batch at `time` or later that is not committed yet.
@@ -1307,10 +1319,7 @@ impl<M: Model> Worker<M> {
             }
             let d = lp.history.pop_front().expect("a batch to commit");
             let state = observed.then(|| match lp.history.front() {
-                Some(next) => next
-                    .pre_state
-                    .clone()
-                    .expect("an uncommitted batch saved its state"),
+                Some(next) => next.pre_state.clone(),
                 None => lp.state.clone(),
             });
             self.uncommitted -= 1;
@@ -1339,6 +1348,7 @@ impl<M: Model> Worker<M> {
             self.ran.pop_front();
         }
         self.stats.committed_early += (before - self.uncommitted) as u64;
+        self.forget_high();
     }
 
     /// Commits every batch before `gvt`: frees its saved state and messages, and returns what
@@ -1372,6 +1382,7 @@ impl<M: Model> Worker<M> {
         }
         let held = self.heap.len() + self.marks.set_aside_len();
         self.samples.push((self.uncommitted + held) as u64);
+        self.forget_high();
         out
     }
 
