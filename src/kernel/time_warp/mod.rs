@@ -1535,3 +1535,59 @@ pub fn chaos_from_env() -> Result<Option<u64>, String> {
             .map_err(|_| format!("POOLSIM_CHAOS: expected a seed (an integer), got `{s}`")),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn handle(to: u32, t: f64) -> Handle {
+        Handle {
+            from: 5,
+            to,
+            seq: 1,
+            uid: uid(5, 1),
+            t,
+        }
+    }
+
+    #[test]
+    fn a_cancelled_message_is_still_to_come_from_the_cancelling_instant_on() {
+        let at = VTime::at(Key::start(2.0)).next_gen();
+        assert!(still_to_come(&handle(3, 2.5), &at));
+        assert!(
+            still_to_come(&handle(3, 2.0), &at),
+            "its own instant: taken at its word"
+        );
+        assert!(
+            !still_to_come(&handle(3, 1.5), &at),
+            "delivered in an earlier instant"
+        );
+        let dropped = Handle {
+            uid: 0,
+            ..handle(3, 2.5)
+        };
+        assert!(
+            !still_to_come(&dropped, &at),
+            "a send into the past was never sent"
+        );
+    }
+
+    #[test]
+    fn a_receiver_rolls_back_from_no_earlier_than_the_cancellations_place() {
+        let at = VTime::at(Key::start(2.0)).next_gen();
+        // a later instant: from its start
+        assert_eq!(
+            not_before(&handle(3, 2.5), at.clone(), 5),
+            VTime::at(Key::start(2.5))
+        );
+        // the same instant, an object after the canceller: from the cancelling batch's time
+        assert_eq!(not_before(&handle(7, 2.0), at.clone(), 5), at);
+        // an object before the canceller: its message comes at a later time than the batch
+        let after = not_before(&handle(3, 2.0), at.clone(), 5);
+        assert!(after > at);
+        assert!(
+            Floor::of(&after, 0) >= Floor::of(&at, 6),
+            "past the op's place"
+        );
+    }
+}
