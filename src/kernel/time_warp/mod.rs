@@ -420,7 +420,8 @@ struct Spare<Msg> {
     sent: Vec<Vec<(Sent, u16)>>,
     /// What the model's handler sends, emptied after every batch.
     pending: Vec<Pending<Msg>>,
-    /// Ops a batch makes, emptied after every batch.
+    /// Cancellations and retractions a batch makes, emptied after every batch (its messages go
+    /// out as it files them).
     ops: Vec<Op<Msg>>,
 }
 
@@ -1021,15 +1022,13 @@ impl<M: Model> Worker<M> {
             self.commit_final(model, li, did, &mut sent, &mut ops);
         } else {
             let mut sent_recs = take(&mut self.spare.sent);
-            for (n, p) in (first + 1..).zip(sent.drain(..)) {
-                let uid = uid(to, n);
+            for (n, p) in (first + 1..).zip(&sent) {
                 let s = Sent {
-                    uid,
+                    uid: uid(to, n),
                     to: p.to,
                     time: p.time.clone(),
                 };
                 sent_recs.push((s, model.kind(&p.env.msg) as u16));
-                ops.push(Op::Msg { uid, p });
             }
             let cancels: Vec<Handle> = cancelled
                 .iter()
@@ -1066,13 +1065,13 @@ impl<M: Model> Worker<M> {
             self.ran.push_back(li as u32);
             self.uncommitted += 1;
             self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
+            for (n, p) in (first + 1..).zip(sent.drain(..)) {
+                self.send(uid(to, n), p);
+            }
         }
         self.spare.pending = sent;
         for op in ops.drain(..) {
-            match op {
-                Op::Msg { uid, p } => self.send(uid, p),
-                op => self.route(op),
-            }
+            self.route(op);
         }
         self.spare.ops = ops;
         self.drain_local();
