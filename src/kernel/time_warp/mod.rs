@@ -948,7 +948,9 @@ impl<M: Model> Worker<M> {
         let mut run_final = self.final_ok && self.may_run_final(fabric, &time, to);
         if run_final {
             let here = Floor::of(&time, to);
-            self.commit_front(model, li, &here);
+            if !self.lps[li].history.is_empty() {
+                self.commit_front(model, li, &here);
+            }
             // a key deeper than a floor keeps may leave batches of the instant uncommitted
             run_final = self.lps[li].history.is_empty();
             if run_final {
@@ -1211,8 +1213,11 @@ impl<M: Model> Worker<M> {
         self.outbox_floor = Floor::INFINITY;
         if self.final_ok {
             let floor = self.local_min();
-            fabric.publish(self.index, floor);
-            self.published = floor;
+            // the slot holds this floor already, or a lower one (taking the inbox lowers it)
+            if floor != self.published {
+                fabric.publish(self.index, floor);
+                self.published = floor;
+            }
         }
     }
 

@@ -52,10 +52,14 @@ impl ThreadReduce {
     }
 }
 
-/// A worker's inbox and what bounds it.
+/// A worker's inbox and what bounds it, on cache lines of its own: its worker writes it every
+/// few batches, and a neighbour's writes would otherwise take the line away from under it.
+#[repr(align(128))]
 struct Slot<Msg> {
     /// Ops sent to it, not taken yet; whoever changes `floors` holds this lock.
     inbox: Mutex<Vec<Op<Msg>>>,
+    /// Whether the inbox may hold ops: its worker takes the lock only then.
+    full: AtomicBool,
     /// Its floors, readable without the lock.
     floors: Floors,
 }
@@ -146,6 +150,7 @@ where
             slots: (0..n)
                 .map(|_| Slot {
                     inbox: Mutex::new(Vec::new()),
+                    full: AtomicBool::new(false),
                     floors: Floors::new(Floor::NEG_INFINITY, Floor::INFINITY),
                 })
                 .collect(),
@@ -173,11 +178,17 @@ where
         }
         let (own, waiting) = slot.floors.current();
         slot.floors.write(own, waiting.min(floor));
+        slot.full.store(true, Ordering::Release);
     }
 
     fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
         let slot = &self.slots[me];
+        // ops sent since this worker looked are taken at its next look
+        if !slot.full.load(Ordering::Acquire) {
+            return;
+        }
         let mut inbox = slot.inbox.lock().expect("no thread panicked");
+        slot.full.store(false, Ordering::Relaxed);
         if inbox.is_empty() {
             return;
         }
