@@ -58,9 +58,11 @@ pub mod mpi;
 pub mod threads;
 
 mod floor;
+mod log;
 mod marks;
 
 pub use floor::Floor;
+use log::{Chain, Log};
 use marks::{Mark, Marks};
 
 use super::queue::Queue;
@@ -70,7 +72,6 @@ use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::cmp::Ordering;
-use std::collections::VecDeque;
 
 /// The deepest key (cascade of immediate events at one instant) Time Warp runs: its GVT does not
 /// tell keys apart past a few steps, so an instant this deep cannot commit, and one that never
@@ -510,15 +511,10 @@ struct Lp<M: Model> {
     state: M::State,
     seq: u64,
     uids: u64,
-    history: VecDeque<Done<M>>,
+    /// Its uncommitted batches in its worker's log.
+    history: Chain,
     /// Whether it is in its worker's list of objects with uncommitted batches.
     active: bool,
-}
-
-impl<M: Model> Lp<M> {
-    fn last_time(&self) -> Option<&VTime> {
-        self.history.back().map(|d| &d.time)
-    }
 }
 
 /// Where each object lives: its worker and its index there.
@@ -599,8 +595,8 @@ pub struct Worker<M: Model> {
     fault: Option<String>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
-    /// Objects in the order their optimistic batches ran, to commit them early.
-    ran: VecDeque<u32>,
+    /// Uncommitted batches in the order they ran (committed early from the front).
+    log: Log<Done<M>>,
     /// The floor this worker published last (with final batches only).
     published: Floor,
     /// Whether batches may run as final ([`TwConfig::final_batches`]).
@@ -652,7 +648,7 @@ impl<M: Model> Worker<M> {
                     state,
                     seq: 0,
                     uids: 0,
-                    history: VecDeque::new(),
+                    history: Chain::EMPTY,
                     active: false,
                 })
                 .collect(),
@@ -683,7 +679,7 @@ impl<M: Model> Worker<M> {
             samples: Vec::new(),
             fault: None,
             active: Vec::new(),
-            ran: VecDeque::new(),
+            log: Log::default(),
             published: Floor::NEG_INFINITY,
             final_ok: false,
             ship: false,
@@ -840,9 +836,9 @@ impl<M: Model> Worker<M> {
     /// Undoes every batch of local object `li` at `time` or later.
     fn rollback(&mut self, li: usize, time: &VTime) {
         self.stats.rollbacks += 1;
-        while self.lps[li].last_time().is_some_and(|t| t >= time) {
+        while self.last_time(li).is_some_and(|t| t >= time) {
             let lp = &mut self.lps[li];
-            let d = lp.history.pop_back().expect("a batch to undo");
+            let d = self.log.pop_last(&mut lp.history).expect("a batch to undo");
             self.uncommitted -= 1;
             self.stats.rolled_back += 1;
             lp.state = d.pre_state;
@@ -940,7 +936,7 @@ impl<M: Model> Worker<M> {
         }
         let li = self.placement.local(to);
         debug_assert!(
-            self.lps[li].last_time().is_none_or(|t| *t < time),
+            self.last_time(li).is_none_or(|t| *t < time),
             "batches run in order"
         );
         // a batch before everything still to come is final, and so are the object's earlier
@@ -1052,7 +1048,7 @@ impl<M: Model> Worker<M> {
             if self.high.as_ref().is_none_or(|h| *h < time) {
                 self.high = Some(time.clone());
             }
-            lp.history.push_back(Done {
+            let done = Done {
                 time,
                 pre_state: pre_state.expect("saved: the batch is not final"),
                 pre_seq,
@@ -1063,8 +1059,8 @@ impl<M: Model> Worker<M> {
                 cancel_calls: cancelled.len() as u32,
                 output,
                 into_past,
-            });
-            self.ran.push_back(li as u32);
+            };
+            self.log.push(&mut lp.history, li as u32, done);
             self.uncommitted += 1;
             self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
             for (n, p) in (first + 1..).zip(sent.drain(..)) {
@@ -1136,11 +1132,16 @@ impl<M: Model> Worker<M> {
         }
     }
 
+    /// The time of local object `li`'s latest uncommitted batch.
+    fn last_time(&self, li: usize) -> Option<&VTime> {
+        self.log.last(&self.lps[li].history).map(|d| &d.time)
+    }
+
     /// Whether local object `li` ran a batch at `time` or later that is not committed yet.
     fn ran_past(&self, li: usize, time: &VTime) -> bool {
         // no batch ran past the latest one run: most messages are later than it
         self.high.as_ref().is_some_and(|h| h >= time)
-            && self.lps[li].last_time().is_some_and(|t| t >= time)
+            && self.last_time(li).is_some_and(|t| t >= time)
     }
 
     /// Notes how many messages this worker holds, for the summary's peak.
@@ -1158,7 +1159,7 @@ impl<M: Model> Worker<M> {
         }
         let t = self.heap.peek().expect("a valid top").p.time.clone();
         for li in 0..self.lps.len() {
-            if self.lps[li].last_time().is_some_and(|x| *x >= t) {
+            if self.last_time(li).is_some_and(|x| *x >= t) {
                 self.stats.artificial_rollbacks += 1;
                 self.rollback(li, &t);
             }
@@ -1314,18 +1315,21 @@ impl<M: Model> Worker<M> {
         let observed = self.ship && model.observed(self.lps[li].id);
         loop {
             let lp = &mut self.lps[li];
-            if !lp
-                .history
-                .front()
+            if !self
+                .log
+                .first(&lp.history)
                 .is_some_and(|d| floor.passed(&d.time, lp.id))
             {
                 break;
             }
-            let d = lp.history.pop_front().expect("a batch to commit");
-            let state = observed.then(|| match lp.history.front() {
+            let state = observed.then(|| match self.log.second(&lp.history) {
                 Some(next) => next.pre_state.clone(),
                 None => lp.state.clone(),
             });
+            let d = self
+                .log
+                .pop_first(&mut lp.history)
+                .expect("a batch to commit");
             self.uncommitted -= 1;
             self.commit(li, d, state);
         }
@@ -1334,22 +1338,20 @@ impl<M: Model> Worker<M> {
     /// Commits optimistic batches, oldest run first, that nothing can undo any more: before
     /// every op the other workers may still send and before this worker's own next batch.
     fn commit_early(&mut self, model: &M) {
-        if !self.final_ok || self.ran.is_empty() {
+        if !self.final_ok || self.log.len() == 0 {
             return;
         }
         // the floor just published is this worker's own next batch; the ops it flushed are
         // still under `final_bound`
         let bound = self.final_bound.min(self.published);
         let before = self.uncommitted;
-        while let Some(&li) = self.ran.front() {
+        // the log's front is the oldest batch of its object
+        while let Some((li, d)) = self.log.front() {
             let li = li as usize;
-            let lp = &self.lps[li];
-            match lp.history.front() {
-                None => {}
-                Some(d) if bound.passed(&d.time, lp.id) => self.commit_front(model, li, &bound),
-                Some(_) => break,
+            if !bound.passed(&d.time, self.lps[li].id) {
+                break;
             }
-            self.ran.pop_front();
+            self.commit_front(model, li, &bound);
         }
         self.stats.committed_early += (before - self.uncommitted) as u64;
         self.forget_high();
