@@ -115,6 +115,39 @@ impl std::hash::Hash for Handle {
     }
 }
 
+/// Names two messages a batch sent at one time, one right after the other, the first to the
+/// sender itself and the second to `other` (a collision's or a passage's pair): what tells
+/// their handles apart, in 24 bytes where the two handles take 80, for states that keep many.
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Pair {
+    /// The first message's send sequence (the second's is the next).
+    seq: u64,
+    /// The first message's transport name (the second's is the next), or 0 if unnamed.
+    uid: u64,
+    /// Their simulation time.
+    t: f64,
+}
+
+impl Pair {
+    /// The handles of the pair object `from` sent: to itself, and to `other`.
+    pub fn handles(&self, from: u32, other: u32) -> [Handle; 2] {
+        let h = Handle {
+            from,
+            to: from,
+            seq: self.seq,
+            uid: self.uid,
+            t: self.t,
+        };
+        let next = Handle {
+            to: other,
+            seq: self.seq + 1,
+            uid: if self.uid == 0 { 0 } else { self.uid + 1 },
+            ..h
+        };
+        [h, next]
+    }
+}
+
 /// A message as delivered: its payload, its sender and its name.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Envelope<M> {
@@ -259,6 +292,11 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
         self
     }
 
+    /// The object handling the batch.
+    pub fn me(&self) -> u32 {
+        self.me
+    }
+
     /// The virtual time of the batch being handled.
     pub fn now(&self) -> &VTime {
         &self.now
@@ -272,6 +310,27 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     /// batch the message is dropped and the batch marked instead).
     pub fn send_at(&mut self, to: u32, time: VTime, msg: M::Msg) -> Handle {
         self.post(to, time, msg, true)
+    }
+
+    /// Sends `mine` to this object and then `theirs` to `other`, both at `time`, as
+    /// [`Ctx::send_at`] does; the pair's name cancels them ([`Ctx::cancel_pair`]).
+    pub fn send_pair(&mut self, other: u32, time: VTime, mine: M::Msg, theirs: M::Msg) -> Pair {
+        let t = time.t();
+        let first = self.send_at(self.me, time.clone(), mine);
+        let second = self.send_at(other, time, theirs);
+        let pair = Pair {
+            seq: first.seq,
+            uid: first.uid,
+            t,
+        };
+        debug_assert!(
+            pair.handles(self.me, other)
+                .iter()
+                .zip([first, second])
+                .all(|(a, b)| (a.to, a.seq, a.uid, a.t) == (b.to, b.seq, b.uid, b.t)),
+            "a pair's handles are consecutive"
+        );
+        pair
     }
 
     /// Sends `msg` to `to` at `time`, as [`Ctx::send_at`], as a message that is never cancelled
@@ -331,6 +390,12 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     /// batch's instant to be still to come).
     pub fn cancel(&mut self, h: Handle) {
         self.cancelled.push(h);
+    }
+
+    /// Retracts both messages of a pair this object sent with `other` ([`Ctx::send_pair`]), as
+    /// [`Ctx::cancel`] does.
+    pub fn cancel_pair(&mut self, pair: Pair, other: u32) {
+        self.cancelled.extend(pair.handles(self.me, other));
     }
 
     /// Reports output (a physical event, a drawing).

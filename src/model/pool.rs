@@ -34,7 +34,7 @@
 
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::Trajectory;
-use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
+use crate::kernel::{Ctx, Envelope, Model, Pair, VTime};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
 use crate::vtime::{pair, Key, DISPLAY, REVERSAL};
@@ -156,17 +156,14 @@ pub const DISPLAY_YOURSELF: usize = 4;
 pub struct Planned {
     /// The other object of the collision (the one that is not the scheduler).
     pub partner: u32,
-    /// The Collision message to the scheduler itself.
-    pub own: Handle,
-    /// The Collision message to the partner.
-    pub other: Handle,
+    /// The Collision messages to the scheduler itself and to the partner.
+    pub sent: Pair,
 }
 
 impl Planned {
     /// Retracts both Collision messages (two thesis Cancel messages).
     pub fn cancel<M: Model + ?Sized>(self, ctx: &mut Ctx<'_, M>) {
-        ctx.cancel(self.own);
-        ctx.cancel(self.other);
+        ctx.cancel_pair(self.sent, self.partner);
     }
 }
 
@@ -358,28 +355,20 @@ impl Pool {
         mine: Option<Arc<BallInfo>>,
         theirs: Option<Arc<BallInfo>>,
     ) -> Planned {
-        let time = VTime::at(key);
-        let own = ctx.send_at(
-            me,
-            time.clone(),
+        debug_assert_eq!(me, ctx.me(), "an object schedules its own collisions");
+        let sent = ctx.send_pair(
+            partner,
+            VTime::at(key),
             PoolMsg::Collision {
                 partner,
                 info: theirs,
             },
-        );
-        let other = ctx.send_at(
-            partner,
-            time,
             PoolMsg::Collision {
                 partner: me,
                 info: mine,
             },
         );
-        Planned {
-            partner,
-            own,
-            other,
-        }
+        Planned { partner, sent }
     }
 
     fn ball_batch(

@@ -33,7 +33,7 @@
 use super::pool::{cancel_with, BallInfo, Planned, Plans};
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::{Trajectory, Vec2};
-use crate::kernel::{Ctx, Envelope, Handle, Model, VTime};
+use crate::kernel::{Ctx, Envelope, Model, Pair, VTime};
 use crate::physics::{self, Contact};
 use crate::polygon::{self, Polygon};
 use crate::scenario::Scenario;
@@ -307,10 +307,8 @@ pub struct Passage {
     /// For an entry, the version of the ball's trajectory it was computed from; `None` for a
     /// departure.
     pub entry: Option<u64>,
-    /// The message to the sector itself.
-    pub own: Handle,
-    /// The message to the ball.
-    pub other: Handle,
+    /// The messages to the sector itself and to the ball.
+    pub sent: Pair,
 }
 
 /// An object's state in the sectored simulation.
@@ -478,30 +476,22 @@ impl Sectored {
         theirs: Option<Arc<BallInfo>>,
         their_version: u64,
     ) -> Planned {
-        let time = VTime::at(key);
-        let own = ctx.send_at(
-            me,
-            time.clone(),
+        debug_assert_eq!(me, ctx.me(), "an object schedules its own collisions");
+        let sent = ctx.send_pair(
+            partner,
+            VTime::at(key),
             SecMsg::Collision {
                 partner,
                 info: theirs,
                 seen: my_version,
             },
-        );
-        let other = ctx.send_at(
-            partner,
-            time,
             SecMsg::Collision {
                 partner: me,
                 info: mine,
                 seen: their_version,
             },
         );
-        Planned {
-            partner,
-            own,
-            other,
-        }
+        Planned { partner, sent }
     }
 
     fn key_of(contact: Contact, parent: &Key, p: crate::vtime::Pair) -> Option<Key> {
@@ -778,28 +768,26 @@ impl Sectored {
         entry: Option<Arc<BallInfo>>,
         time: VTime,
     ) -> Passage {
+        debug_assert_eq!(me, ctx.me(), "a sector schedules its own passages");
         let version = entry.as_ref().map(|e| e.version);
-        let (own, other) = match entry {
+        let sent = match entry {
             Some(info) => {
                 let entering = |info| SecMsg::SectorEntry {
                     ball,
                     sector: me,
                     info,
                 };
-                let own = ctx.send_at(me, time.clone(), entering(Some(info)));
-                (own, ctx.send_at(ball, time, entering(None)))
+                ctx.send_pair(ball, time, entering(Some(info)), entering(None))
             }
             None => {
                 let msg = SecMsg::SectorDeparture { ball, sector: me };
-                let own = ctx.send_at(me, time.clone(), msg.clone());
-                (own, ctx.send_at(ball, time, msg))
+                ctx.send_pair(ball, time, msg.clone(), msg)
             }
         };
         Passage {
             ball,
             entry: version,
-            own,
-            other,
+            sent,
         }
     }
 
@@ -807,8 +795,7 @@ impl Sectored {
     fn cancel_passage(ctx: &mut Ctx<'_, Sectored>, planned: &mut Vec<Passage>, ball: u32) {
         if let Some(k) = planned.iter().position(|p| p.ball == ball) {
             let p = planned.swap_remove(k);
-            ctx.cancel(p.own);
-            ctx.cancel(p.other);
+            ctx.cancel_pair(p.sent, p.ball);
         }
     }
 
