@@ -86,12 +86,17 @@ impl<Msg> Marks<Msg> {
     }
 
     /// Takes a message that is not live off the heap's hands: an annulled one is dropped (its
-    /// anti-message is spent), a cancelled one set aside.
-    pub fn set_aside(&mut self, uid: u64, p: Pending<Msg>, mark: Mark) {
+    /// anti-message is spent), a cancelled one set aside, or dropped too if a batch before
+    /// `gvt` cancelled it (committed: for good).
+    pub fn set_aside(&mut self, uid: u64, p: Pending<Msg>, mark: Mark, gvt: f64) {
         match mark {
             Mark::Annulled => self.unmark(uid),
             Mark::Cancelled => {
-                self.dead.insert(uid, p);
+                if self.cancels.get(&uid).is_some_and(|c| c.committed(gvt)) {
+                    self.cancels.remove(&uid);
+                } else {
+                    self.dead.insert(uid, p);
+                }
             }
             Mark::Live => unreachable!("a live message is delivered, not set aside"),
         }
@@ -133,13 +138,21 @@ impl<Msg> Marks<Msg> {
     }
 
     /// Counts a cancellation of message `uid` (at simulation time `t`) by a batch at `at`
-    /// (`sign` 1) or its undoing (-1). Returns the message if the cancellation no longer
-    /// stands and the message was set aside.
-    pub fn cancel(&mut self, uid: u64, t: f64, at: f64, sign: i8) -> Option<Pending<Msg>> {
-        let c = self.cancels.entry(uid).or_insert_with(|| Cancels {
-            t,
-            by: SmallVec::new(),
-        });
+    /// (`sign` 1) or its undoing (-1). Returns whether the message's standing changed
+    /// (cancelled or not), and the message if the cancellation no longer stands and the
+    /// message was set aside.
+    pub fn cancel(&mut self, uid: u64, t: f64, at: f64, sign: i8) -> (bool, Option<Pending<Msg>>) {
+        use std::collections::hash_map::Entry;
+        let c = match self.cancels.entry(uid) {
+            Entry::Occupied(e) => e.into_mut(),
+            Entry::Vacant(e) => {
+                e.insert(Cancels {
+                    t,
+                    by: smallvec::smallvec![(at, i32::from(sign))],
+                });
+                return (true, None);
+            }
+        };
         match c.by.iter().position(|b| b.0.to_bits() == at.to_bits()) {
             Some(k) => {
                 c.by[k].1 += i32::from(sign);
@@ -151,9 +164,9 @@ impl<Msg> Marks<Msg> {
         }
         if c.by.is_empty() {
             self.cancels.remove(&uid);
-            return self.dead.remove(&uid);
+            return (true, self.dead.remove(&uid));
         }
-        None
+        (false, None)
     }
 
     /// Cancelled messages set aside.
@@ -238,7 +251,7 @@ mod tests {
         // the message first, in the heap: it is dropped when it reaches the top
         assert!(m.arrives(8, true));
         m.annul(8);
-        m.set_aside(8, msg(1.0), Mark::Annulled);
+        m.set_aside(8, msg(1.0), Mark::Annulled, 0.0);
         assert_eq!(m.pending_marks(), 0);
     }
 
@@ -253,7 +266,7 @@ mod tests {
         assert_eq!((m.of(5, true), m.pending_marks()), (Mark::Live, 0));
         // a message set aside as cancelled is dropped at once
         m.cancel(6, 2.0, 1.0, 1);
-        m.set_aside(6, msg(2.0), Mark::Cancelled);
+        m.set_aside(6, msg(2.0), Mark::Cancelled, 0.0);
         assert!(m.retract(6));
         assert_eq!(m.set_aside_len(), 0);
         // one in the heap is dropped when it reaches the top, which spends the mark (message
@@ -267,20 +280,22 @@ mod tests {
     #[test]
     fn a_cancellation_undone_brings_its_message_back() {
         let mut m: Marks<u8> = Marks::default();
-        assert!(m.cancel(3, 2.0, 1.0, 1).is_none());
+        assert!(matches!(m.cancel(3, 2.0, 1.0, 1), (true, None)));
         assert_eq!(m.of(3, true), Mark::Cancelled);
         assert_eq!(m.of(3, false), Mark::Live, "a relay is never cancelled");
-        m.set_aside(3, msg(2.0), Mark::Cancelled);
+        m.set_aside(3, msg(2.0), Mark::Cancelled, 0.0);
         assert_eq!(m.set_aside_len(), 1);
-        let back = m
-            .cancel(3, 2.0, 1.0, -1)
-            .expect("set aside, and live again");
-        assert_eq!(back.time.t(), 2.0);
+        let (changed, back) = m.cancel(3, 2.0, 1.0, -1);
+        assert!(changed);
+        assert_eq!(back.expect("set aside, and live again").time.t(), 2.0);
         assert_eq!((m.of(3, true), m.set_aside_len()), (Mark::Live, 0));
         // an undoing that arrives before its cancellation cancels until they meet
-        assert!(m.cancel(4, 2.0, 1.0, -1).is_none());
+        assert!(matches!(m.cancel(4, 2.0, 1.0, -1), (true, None)));
         assert_eq!(m.of(4, true), Mark::Cancelled);
-        assert!(m.cancel(4, 2.0, 1.0, 1).is_none());
+        // a second cancellation by another batch changes nothing until both are undone
+        assert!(matches!(m.cancel(4, 2.0, 1.5, 1), (false, None)));
+        assert!(matches!(m.cancel(4, 2.0, 1.5, -1), (false, None)));
+        assert!(matches!(m.cancel(4, 2.0, 1.0, 1), (true, None)));
         assert_eq!(m.of(4, true), Mark::Live);
     }
 
@@ -291,13 +306,17 @@ mod tests {
             ..Marks::default()
         };
         m.cancel(1, 5.0, 1.0, 1);
-        m.set_aside(1, msg(5.0), Mark::Cancelled);
+        m.set_aside(1, msg(5.0), Mark::Cancelled, 0.0);
         m.cancel(2, 5.0, 3.0, 1);
-        m.set_aside(2, msg(5.0), Mark::Cancelled);
+        m.set_aside(2, msg(5.0), Mark::Cancelled, 0.0);
         // GVT 2: message 1's cancellation is committed, message 2's may still be undone
         m.collect(2.0);
         assert_eq!(m.set_aside_len(), 1);
         assert_eq!(m.of(2, true), Mark::Cancelled);
+        // one whose cancellation is committed when it leaves the heap is dropped at once
+        m.cancel(5, 6.0, 1.0, 1);
+        m.set_aside(5, msg(6.0), Mark::Cancelled, 2.0);
+        assert_eq!((m.set_aside_len(), m.of(5, true)), (1, Mark::Live));
         // a cancelled message still in the heap stays until its cancellation is committed
         m.cancel(9, 5.0, 3.0, 1);
         assert!(

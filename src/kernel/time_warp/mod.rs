@@ -419,6 +419,7 @@ struct Spare<Msg> {
     inputs: Vec<Vec<Input>>,
     batches: Vec<Vec<Envelope<Msg>>>,
     sent: Vec<Vec<(Sent, u16)>>,
+    cancels: Vec<Vec<Handle>>,
     /// What the model's handler sends, emptied after every batch.
     pending: Vec<Pending<Msg>>,
     /// Cancellations and retractions a batch makes, emptied after every batch (its messages go
@@ -435,6 +436,7 @@ impl<Msg> Default for Spare<Msg> {
             inputs: Vec::new(),
             batches: Vec::new(),
             sent: Vec::new(),
+            cancels: Vec::new(),
             pending: Vec::new(),
             ops: Vec::new(),
         }
@@ -782,7 +784,7 @@ impl<M: Model> Worker<M> {
                     return; // its anti-message or retraction came first
                 }
                 if p.retractable && self.marks.cancelled(uid) {
-                    self.marks.set_aside(uid, p, Mark::Cancelled);
+                    self.marks.set_aside(uid, p, Mark::Cancelled, self.gvt.t);
                     return;
                 }
                 if self.ran_past(li, &p.time) {
@@ -806,9 +808,8 @@ impl<M: Model> Worker<M> {
                 }
             }
             Op::Cancel { h, at, by, sign } => {
-                let before = self.marks.cancelled(h.uid);
-                let back = self.marks.cancel(h.uid, h.t, at.t(), sign);
-                if before != self.marks.cancelled(h.uid) && h.to != by {
+                let (changed, back) = self.marks.cancel(h.uid, h.t, at.t(), sign);
+                if changed && h.to != by {
                     self.undo_handling(li, &not_before(&h, at, by));
                 }
                 if let Some(p) = back {
@@ -859,7 +860,8 @@ impl<M: Model> Worker<M> {
             give(&mut self.spare.inputs, inputs);
             give(&mut self.spare.batches, batch);
             give(&mut self.spare.sent, sent);
-            for h in d.cancels {
+            let mut cancels = d.cancels;
+            for h in cancels.drain(..) {
                 let op = Op::Cancel {
                     h,
                     at: d.time.clone(),
@@ -868,6 +870,7 @@ impl<M: Model> Worker<M> {
                 };
                 self.route(op);
             }
+            give(&mut self.spare.cancels, cancels);
         }
     }
 
@@ -880,7 +883,7 @@ impl<M: Model> Worker<M> {
                 return Some(top.p.time.t());
             }
             let it = self.heap.pop().expect("a top");
-            self.marks.set_aside(it.uid, it.p, mark);
+            self.marks.set_aside(it.uid, it.p, mark, self.gvt.t);
         }
     }
 
@@ -978,7 +981,7 @@ impl<M: Model> Worker<M> {
                     }
                     batch.push(env);
                 }
-                mark => self.marks.set_aside(it.uid, it.p, mark),
+                mark => self.marks.set_aside(it.uid, it.p, mark, self.gvt.t),
             }
         }
         // the next batch's object, most likely: its record loads while this batch runs
@@ -1028,11 +1031,12 @@ impl<M: Model> Worker<M> {
                 };
                 sent_recs.push((s, model.kind(&p.env.msg) as u16));
             }
-            let cancels: Vec<Handle> = cancelled
-                .iter()
-                .filter(|h| still_to_come(h, &time))
-                .copied()
-                .collect();
+            let mut cancels = if cancelled.is_empty() {
+                Vec::new()
+            } else {
+                take(&mut self.spare.cancels)
+            };
+            cancels.extend(cancelled.iter().filter(|h| still_to_come(h, &time)));
             for &h in &cancels {
                 ops.push(Op::Cancel {
                     h,
@@ -1274,6 +1278,7 @@ impl<M: Model> Worker<M> {
         give(&mut self.spare.sent, d.sent);
         give(&mut self.spare.inputs, d.inputs);
         give(&mut self.spare.batches, d.batch);
+        give(&mut self.spare.cancels, d.cancels);
         self.keep_for_collector(d.time, self.lps[li].id, state, d.output);
     }
 
