@@ -72,13 +72,7 @@ pub fn sectored(s: &Scenario, layout: &Layout, workers: usize) -> Vec<u32> {
     let home: Vec<u32> = s
         .balls
         .iter()
-        .map(|b| {
-            layout
-                .touching(b.position, 0.0)
-                .first()
-                .copied()
-                .unwrap_or(0)
-        })
+        .map(|b| layout.home(b.position).unwrap_or(0))
         .collect();
     let mut load = vec![1.0; layout.polys.len()];
     for &k in &home {

@@ -114,6 +114,13 @@ impl BoxIndex {
         }
     }
 
+    /// Sectors whose boxes may hold the point `p`, ascending (the sectors were filed in order).
+    fn at(&self, p: Vec2) -> &[u32] {
+        let x = self.range(p.x, self.lo.x, self.cell.x, self.nx);
+        let y = self.range(p.y, self.lo.y, self.cell.y, self.ny);
+        &self.buckets[y * self.nx + x]
+    }
+
     /// Sectors whose boxes may meet the box `[a, b]`, each once, ascending.
     fn candidates(&self, a: Vec2, b: Vec2) -> Vec<u32> {
         let (x0, x1) = (
@@ -171,6 +178,15 @@ impl Layout {
         let nx = ((span.x / side).round() as u32).max(1);
         let ny = ((span.y / side).round() as u32).max(1);
         Layout::grid(table, nx, ny)
+    }
+
+    /// The first sector (by id) that holds point `p`, as `touching(p, 0.0)` would list first.
+    pub fn home(&self, p: Vec2) -> Option<u32> {
+        self.index
+            .at(p)
+            .iter()
+            .copied()
+            .find(|&k| polygon::touches(&self.polys[k as usize], p, 0.0))
     }
 
     /// The sectors a disk at `centre` with radius `r` touches.
@@ -1031,6 +1047,26 @@ impl Model for Sectored {
 mod tests {
     use super::*;
     use crate::scenario::builtin::{build, Params};
+
+    #[test]
+    fn a_points_home_is_the_first_sector_that_holds_it() {
+        let s = build("gas", &Params::default()).unwrap();
+        let table = Table::new(&s);
+        let span = table.hi - table.lo;
+        for (nx, ny) in [(1, 1), (3, 2), (7, 5), (16, 16)] {
+            let layout = Layout::grid(&table, nx, ny);
+            // points on a fine lattice, corners and borders between sectors included
+            for i in 0..=4 * nx {
+                for j in 0..=4 * ny {
+                    let p = Vec2::new(
+                        table.lo.x + span.x * i as f64 / (4 * nx) as f64,
+                        table.lo.y + span.y * j as f64 / (4 * ny) as f64,
+                    );
+                    assert_eq!(layout.home(p), layout.touching(p, 0.0).first().copied());
+                }
+            }
+        }
+    }
 
     #[test]
     fn fixed_objects_hear_from_the_sectors_within_reach() {
