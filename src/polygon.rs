@@ -411,6 +411,27 @@ pub fn adjacency(polys: &[Polygon], tol: f64) -> Vec<Vec<u32>> {
     out
 }
 
+/// [`adjacency`] of [`grid`]`(lo, hi, nx, ny)`, read off the grid: each cell's neighbours across
+/// its edges and corners, ascending.
+pub fn grid_adjacency(nx: u32, ny: u32) -> Vec<Vec<u32>> {
+    let (nx, ny) = (nx as usize, ny as usize);
+    let mut out = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let mut list = Vec::with_capacity(8);
+            for y in j.saturating_sub(1)..(j + 2).min(ny) {
+                for x in i.saturating_sub(1)..(i + 2).min(nx) {
+                    if (x, y) != (i, j) {
+                        list.push((y * nx + x) as u32);
+                    }
+                }
+            }
+            out.push(list);
+        }
+    }
+    out
+}
+
 /// Whether a disk of radius `r` centred at `centre` touches the polygon: the distance from the
 /// centre to the closed polygon is at most `r`.
 pub fn touches(poly: &Polygon, centre: Vec2, r: f64) -> bool {
@@ -1125,6 +1146,15 @@ mod tests {
         assert_eq!(adj[0], vec![1, 3, 4]);
         assert_eq!(adj[1], vec![0, 2, 3, 4, 5]);
         assert_eq!(adj[8], vec![4, 5, 7]);
+        // read off the grid, as the sectored engines do, it is the same for any grid
+        let (lo, hi) = (v(-3.7, 1.1), v(1234.567, 890.123));
+        for (nx, ny) in [(1, 1), (1, 4), (5, 1), (3, 3), (7, 5), (40, 31)] {
+            let tol = 1e-9 * (hi - lo).norm();
+            assert_eq!(
+                grid_adjacency(nx, ny),
+                adjacency(&grid(lo, hi, nx, ny), tol)
+            );
+        }
     }
 
     #[test]

@@ -154,6 +154,11 @@ impl Layout {
     fn covering(polys: Vec<Polygon>, table: &Table) -> Layout {
         let size = (table.hi - table.lo).norm();
         let adjacent = polygon::adjacency(&polys, 1e-9 * size);
+        Layout::with_adjacency(polys, adjacent, table)
+    }
+
+    /// A layout of polygons that cover the table's box, with their adjacency.
+    fn with_adjacency(polys: Vec<Polygon>, adjacent: Vec<Vec<u32>>, table: &Table) -> Layout {
         let index = BoxIndex::new(&polys, table.lo, table.hi);
         Layout {
             polys,
@@ -167,7 +172,8 @@ impl Layout {
     pub fn grid(table: &Table, nx: u32, ny: u32) -> Layout {
         // a grid covers its box exactly (a unit test checks it), so it skips the validation
         // that a layout read from a file needs
-        Layout::covering(polygon::grid(table.lo, table.hi, nx, ny), table)
+        let polys = polygon::grid(table.lo, table.hi, nx, ny);
+        Layout::with_adjacency(polys, polygon::grid_adjacency(nx, ny), table)
     }
 
     /// The grid the analytic model suggests (thesis ch. 7): square-ish sectors holding about
