@@ -333,6 +333,10 @@ pub struct Passage {
     pub sent: Pair,
 }
 
+/// The sectors a ball's disk touches: rarely more than four, kept inline so that saving the
+/// ball's state (Time Warp) allocates nothing for them.
+pub type Sectors = SmallVec<[u32; 4]>;
+
 /// An object's state in the sectored simulation.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub enum SecState {
@@ -343,7 +347,7 @@ pub enum SecState {
         /// Collisions it scheduled.
         planned: Vec<Planned>,
         /// Sectors its disk touches.
-        sectors: Vec<u32>,
+        sectors: Sectors,
         /// Ball–ball collisions awaiting the partner's confirmation: partner, own validity.
         awaiting: Vec<(u32, bool)>,
     },
@@ -396,7 +400,7 @@ impl Sectored {
                 version: 0,
                 pocket: None,
             });
-            let sectors: Vec<u32> = layout
+            let sectors: Sectors = layout
                 .touching(b.position, b.radius)
                 .into_iter()
                 .map(|k| {
@@ -531,7 +535,7 @@ impl Sectored {
         me: u32,
         info: &mut Arc<BallInfo>,
         planned: &mut Vec<Planned>,
-        sectors: &mut Vec<u32>,
+        sectors: &mut Sectors,
         awaiting: &mut Vec<(u32, bool)>,
         batch: &[Envelope<SecMsg>],
     ) {
