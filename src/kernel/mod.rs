@@ -219,6 +219,17 @@ impl<M> Pending<M> {
             .then(self.env.seq.cmp(&o.env.seq))
     }
 
+    /// Integers that order messages of one key as [`Pending::order`] does, then by `uid`:
+    /// generation and receiver, priority and sender, sequence, `uid`.
+    pub fn rank(&self, uid: u64) -> [u64; 4] {
+        [
+            u64::from(self.time.gen) << 32 | u64::from(self.to),
+            u64::from(self.priority) << 32 | u64::from(self.env.from),
+            self.env.seq,
+            uid,
+        ]
+    }
+
     /// This message's handle (with no transport name).
     pub fn handle(&self) -> Handle {
         Handle {

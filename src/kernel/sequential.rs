@@ -1,6 +1,6 @@
 //! The sequential executor: one pending set ([`Queue`]), batches run strictly in order.
 
-use super::queue::Queue;
+use super::queue::{Queue, Ranked};
 use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
 use crate::engine::prefetch::{prefetch, prefetch_all};
 use rustc_hash::FxHashSet;
@@ -30,6 +30,15 @@ impl<M> PartialOrd for Item<M> {
 impl<M> Ord for Item<M> {
     fn cmp(&self, o: &Self) -> Ordering {
         o.0.order(&self.0)
+    }
+}
+
+impl<M> Ranked for Item<M> {
+    fn rank(&self) -> [u64; 4] {
+        self.0.rank(0).map(|x| !x)
+    }
+    fn same_instant(&self, o: &Self) -> bool {
+        self.0.time.key == o.0.time.key
     }
 }
 

@@ -65,7 +65,7 @@ pub use floor::Floor;
 use log::{Chain, Log};
 use marks::{Mark, Marks};
 
-use super::queue::Queue;
+use super::queue::{Queue, Ranked};
 use super::{uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
 use crate::engine::prefetch::prefetch_all;
 use crate::vtime::Key;
@@ -395,6 +395,16 @@ impl<Msg> PartialOrd for Item<Msg> {
 impl<Msg> Ord for Item<Msg> {
     fn cmp(&self, o: &Self) -> Ordering {
         o.order(self)
+    }
+}
+
+impl<Msg> Ranked for Item<Msg> {
+    fn rank(&self) -> [u64; 4] {
+        // the heap's order is the delivery order reversed
+        self.p.rank(self.uid).map(|x| !x)
+    }
+    fn same_instant(&self, o: &Self) -> bool {
+        self.p.time.key == o.p.time.key
     }
 }
 
