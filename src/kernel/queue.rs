@@ -26,7 +26,7 @@ pub trait Ranked: Ord {
 fn sort<T: Ranked>(v: &mut [T]) {
     match v.first() {
         Some(first) if v.len() >= SORT_BY_RANK && v.iter().all(|x| x.same_instant(first)) => {
-            v.sort_unstable_by(|a, b| a.rank().cmp(&b.rank()));
+            v.sort_unstable_by_key(T::rank);
         }
         _ => v.sort_unstable(),
     }
