@@ -4,9 +4,9 @@
 //! ```text
 //!   worker 0                         worker 1
 //!   ┌───────────────────────┐  ops   ┌───────────────────────┐
-//!   │ objects (LPs):        │ ─────► │ heap of messages not  │
-//!   │  state, history of    │ ◄───── │ handled yet; marks by │
-//!   │  done batches         │        │ uid: anti, cancelled  │
+//!   │ objects (LPs): state; │ ─────► │ heap of messages not  │
+//!   │ log of uncommitted    │ ◄───── │ handled yet; marks by │
+//!   │ batches, saved states │        │ uid: anti, cancelled  │
 //!   └───────────┬───────────┘        └───────────┬───────────┘
 //!               └──── GVT round (reduce) ────────┘──► committed chunks ─► collector ─► sink
 //! ```
