@@ -73,7 +73,7 @@ where
         }
     }
 
-    /// Messages waiting.
+    /// Messages waiting, cancelled ones not yet discarded included.
     pub fn pending_len(&self) -> usize {
         match self {
             Exec::Sequential(e) => e.pending_len(),

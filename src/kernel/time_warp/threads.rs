@@ -491,7 +491,8 @@ where
         s
     }
 
-    /// Live messages waiting (every rank's, on rank 0 under MPI).
+    /// Messages waiting, marked ones not yet discarded included (every rank's, on rank 0 under
+    /// MPI).
     pub fn pending_len(&self) -> usize {
         self.collector.pending as usize
     }
