@@ -437,22 +437,55 @@ where
         let per = cfg.workers.max(1);
         let placement = Arc::new(Placement::new(worker_of, per * ranks));
         let mine = rank * per..(rank + 1) * per;
+        // this rank's objects move to their workers, which copy them for the collector and run
+        // their `init`s on a thread each; the collector keeps the other ranks' objects as they are
+        let n = states.len();
         let mut local: Vec<Vec<(u32, M::State)>> = (0..per).map(|_| Vec::new()).collect();
-        for (o, s) in states.iter().enumerate() {
+        let mut kept: Vec<Option<M::State>> = Vec::with_capacity(n);
+        for (o, s) in states.into_iter().enumerate() {
             let w = placement.worker(o as u32);
             if mine.contains(&w) {
-                local[w - mine.start].push((o as u32, s.clone()));
+                local[w - mine.start].push((o as u32, s));
+                kept.push(None);
+            } else {
+                kept.push(Some(s));
             }
         }
-        let mut workers: Vec<Worker<M>> = local
+        let model_ref = &model;
+        let built: Vec<(Worker<M>, Vec<(u32, M::State)>)> = std::thread::scope(|scope| {
+            let handles: Vec<_> = local
+                .into_iter()
+                .enumerate()
+                .map(|(k, st)| {
+                    let (placement, start) = (placement.clone(), &start);
+                    scope.spawn(move || {
+                        let copies: Vec<(u32, M::State)> =
+                            st.iter().map(|(o, s)| (*o, s.clone())).collect();
+                        let mut w = Worker::new(mine.start + k, placement, st, cfg.chaos);
+                        w.init(model_ref, start);
+                        (w, copies)
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("a worker's set-up does not panic"))
+                .collect()
+        });
+        let mut workers = Vec::with_capacity(per);
+        for (w, copies) in built {
+            for (o, s) in copies {
+                kept[o as usize] = Some(s);
+            }
+            workers.push(w);
+        }
+        let states: Vec<M::State> = kept
             .into_iter()
-            .enumerate()
-            .map(|(k, st)| Worker::new(mine.start + k, placement.clone(), st, cfg.chaos))
+            .map(|s| s.expect("every object kept or copied"))
             .collect();
         // init's sends to this rank's workers are delivered here; others wait in outboxes
         let mut mail: Vec<Vec<Op<M::Msg>>> = (0..per).map(|_| Vec::new()).collect();
         for w in &mut workers {
-            w.init(&model, &start);
             for (to, ops) in w.take_outbox(mine.clone()) {
                 mail[to - mine.start].extend(ops);
             }
