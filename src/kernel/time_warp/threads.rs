@@ -452,7 +452,7 @@ where
             }
         }
         let model_ref = &model;
-        let built: Vec<(Worker<M>, Vec<(u32, M::State)>)> = std::thread::scope(|scope| {
+        let built: Vec<_> = std::thread::scope(|scope| {
             let handles: Vec<_> = local
                 .into_iter()
                 .enumerate()
