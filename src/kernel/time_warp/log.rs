@@ -69,6 +69,12 @@ impl<T> Log<T> {
         self.live
     }
 
+    /// Slots from the oldest record to the newest: the records, and the holes between them
+    /// that records taken from the middle left.
+    pub fn slots(&self) -> usize {
+        self.ring.len()
+    }
+
     /// Appends `item` as the latest record of object `owner`, whose chain is `chain`.
     pub fn push(&mut self, chain: &mut Chain, owner: u32, item: T) {
         let n = self.base + self.ring.len() as u64;
@@ -181,10 +187,22 @@ mod tests {
         assert_eq!(log.pop_first(&mut a), Some(10));
         assert_eq!(log.front(), Some((1, &20)));
         assert_eq!(log.last(&b), Some(&22));
+        // a's oldest left a hole at the front, trimmed; b's latest one at the back, trimmed
+        assert_eq!((log.len(), log.slots()), (6, 6));
+        assert_eq!(log.pop_first(&mut a), Some(11));
+        assert_eq!(
+            (log.len(), log.slots()),
+            (5, 6),
+            "a hole in the middle stays"
+        );
         // taking every record leaves nothing, from whichever end
         assert_eq!(log.pop_first(&mut b), Some(20));
-        assert_eq!(log.front(), Some((0, &11)));
-        for want in [13, 12, 11] {
+        assert_eq!(
+            log.front(),
+            Some((1, &21)),
+            "the hole after 20 is trimmed too"
+        );
+        for want in [13, 12] {
             assert_eq!(log.pop_last(&mut a), Some(want));
         }
         assert!(a.is_empty() && log.first(&a).is_none() && log.pop_last(&mut a).is_none());

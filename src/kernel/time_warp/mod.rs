@@ -1145,6 +1145,14 @@ impl<M: Model> Worker<M> {
         }
     }
 
+    /// Uncommitted batches as memory holds them: the slots of the log from the oldest to the
+    /// newest, those that batches committed out of order left empty included (an old batch far
+    /// ahead of GVT keeps them all; the memory budget counts them, so that rolling it back
+    /// frees them).
+    fn held(&self) -> usize {
+        self.log.slots()
+    }
+
     /// The time of local object `li`'s latest uncommitted batch.
     fn last_time(&self, li: usize) -> Option<&VTime> {
         self.log.last(&self.lps[li].history).map(|d| &d.time)
@@ -1439,8 +1447,8 @@ impl<M: Model> Worker<M> {
             let mut ran = 0;
             let mut held_back = false;
             while ran < burst {
-                if self.uncommitted > cfg.max_uncommitted {
-                    if self.uncommitted > cfg.max_uncommitted.saturating_mul(4) {
+                if self.held() > cfg.max_uncommitted {
+                    if self.held() > cfg.max_uncommitted.saturating_mul(4) {
                         break;
                     }
                     self.artificial_rollback();
@@ -1463,7 +1471,7 @@ impl<M: Model> Worker<M> {
             if ran == 0 && self.chaos.is_none() {
                 std::thread::yield_now();
             }
-            let over = self.uncommitted > cfg.max_uncommitted.saturating_mul(4);
+            let over = self.held() > cfg.max_uncommitted.saturating_mul(4);
             if over || self.fault.is_some() {
                 since = cfg.gvt_interval;
             }
@@ -1487,7 +1495,9 @@ impl<M: Model> Worker<M> {
                     break Err(Stop::Failed(format!(
                         "time warp: worker {} holds {} uncommitted batches, over 4 x its budget \
                          of {} (raise --tw-memory or narrow --tw-window)",
-                        self.index, self.uncommitted, cfg.max_uncommitted
+                        self.index,
+                        self.held(),
+                        cfg.max_uncommitted
                     )))
                 }
                 Err(s) => break Err(s),
