@@ -114,33 +114,27 @@ impl<T> Log<T> {
 
     /// Takes the latest record of `chain`.
     pub fn pop_last(&mut self, chain: &mut Chain) -> Option<T> {
-        if chain.last == NONE {
-            return None;
-        }
-        let e = self.entry_mut(chain.last);
-        let (item, prev) = (e.item.take(), e.prev);
-        chain.last = prev;
-        if prev == NONE {
-            chain.first = NONE;
-        } else {
-            self.entry_mut(prev).next = NONE;
-        }
-        self.taken();
-        item
+        (chain.last != NONE).then(|| self.unlink(chain, chain.last))
     }
 
     /// Takes the oldest record of `chain`.
     pub fn pop_first(&mut self, chain: &mut Chain) -> Option<T> {
-        if chain.first == NONE {
-            return None;
-        }
-        let e = self.entry_mut(chain.first);
-        let (item, next) = (e.item.take(), e.next);
-        chain.first = next;
-        if next == NONE {
-            chain.last = NONE;
+        (chain.first != NONE).then(|| self.unlink(chain, chain.first))
+    }
+
+    /// Takes record `n` out of `chain`, leaving a hole.
+    fn unlink(&mut self, chain: &mut Chain, n: u64) -> T {
+        let e = self.entry_mut(n);
+        let (item, prev, next) = (e.item.take().expect("live"), e.prev, e.next);
+        if prev == NONE {
+            chain.first = next;
         } else {
-            self.entry_mut(next).prev = NONE;
+            self.entry_mut(prev).next = next;
+        }
+        if next == NONE {
+            chain.last = prev;
+        } else {
+            self.entry_mut(next).prev = prev;
         }
         self.taken();
         item
