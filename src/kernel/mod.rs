@@ -119,7 +119,7 @@ impl std::hash::Hash for Handle {
 /// sender itself and the second to `other` (a collision's or a passage's pair): what tells
 /// their handles apart, in 24 bytes where the two handles take 80, for states that keep many.
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
-pub struct Pair {
+pub struct SentPair {
     /// The first message's send sequence (the second's is the next).
     seq: u64,
     /// The first message's transport name (the second's is the next), or 0 if unnamed.
@@ -128,7 +128,7 @@ pub struct Pair {
     t: f64,
 }
 
-impl Pair {
+impl SentPair {
     /// The handles of the pair object `from` sent: to itself, and to `other`.
     pub fn handles(&self, from: u32, other: u32) -> [Handle; 2] {
         let h = Handle {
@@ -325,11 +325,11 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
 
     /// Sends `mine` to this object and then `theirs` to `other`, both at `time`, as
     /// [`Ctx::send_at`] does; the pair's name cancels them ([`Ctx::cancel_pair`]).
-    pub fn send_pair(&mut self, other: u32, time: VTime, mine: M::Msg, theirs: M::Msg) -> Pair {
+    pub fn send_pair(&mut self, other: u32, time: VTime, mine: M::Msg, theirs: M::Msg) -> SentPair {
         let t = time.t();
         let first = self.send_at(self.me, time.clone(), mine);
         let second = self.send_at(other, time, theirs);
-        let pair = Pair {
+        let pair = SentPair {
             seq: first.seq,
             uid: first.uid,
             t,
@@ -405,7 +405,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
 
     /// Retracts both messages of a pair this object sent with `other` ([`Ctx::send_pair`]), as
     /// [`Ctx::cancel`] does.
-    pub fn cancel_pair(&mut self, pair: Pair, other: u32) {
+    pub fn cancel_pair(&mut self, pair: SentPair, other: u32) {
         self.cancelled.extend(pair.handles(self.me, other));
     }
 

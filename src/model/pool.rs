@@ -34,7 +34,7 @@
 
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::Trajectory;
-use crate::kernel::{Ctx, Envelope, Model, Pair, VTime};
+use crate::kernel::{Ctx, Envelope, Model, SentPair, VTime};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
 use crate::vtime::{pair, Key, DISPLAY, REVERSAL};
@@ -157,7 +157,7 @@ pub struct Planned {
     /// The other object of the collision (the one that is not the scheduler).
     pub partner: u32,
     /// The Collision messages to the scheduler itself and to the partner.
-    pub sent: Pair,
+    pub sent: SentPair,
 }
 
 impl Planned {

@@ -33,7 +33,7 @@
 use super::pool::{cancel_with, BallInfo, Planned, Plans};
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::{Trajectory, Vec2};
-use crate::kernel::{Ctx, Envelope, Model, Pair, VTime};
+use crate::kernel::{Ctx, Envelope, Model, SentPair, VTime};
 use crate::physics::{self, Contact};
 use crate::polygon::{self, Polygon};
 use crate::scenario::Scenario;
@@ -330,7 +330,7 @@ pub struct Passage {
     /// departure.
     pub entry: Option<u64>,
     /// The messages to the sector itself and to the ball.
-    pub sent: Pair,
+    pub sent: SentPair,
 }
 
 /// The sectors a ball's disk touches: rarely more than four, kept inline so that saving the
