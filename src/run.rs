@@ -261,6 +261,7 @@ pub fn execute(
             };
             let out = e.run(cfg.until, &mut sinks)?;
             time_warp = e.tw_stats();
+            e.free();
             out
         }
     };

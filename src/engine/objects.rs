@@ -49,6 +49,14 @@ where
         }
     }
 
+    /// Frees the executor (Time Warp's workers each on its own thread).
+    fn free(self) {
+        match self {
+            Exec::Sequential(e) => drop(e),
+            Exec::TimeWarp(e) => e.free(),
+        }
+    }
+
     /// The model.
     pub fn model(&self) -> &M {
         match self {
@@ -205,6 +213,15 @@ impl Objects {
         match self {
             Objects::Plain(e) => e.stats(),
             Objects::Sectored(e) => e.stats(),
+        }
+    }
+
+    /// Frees the engine: under Time Warp each worker's memory on a thread of its own, else as
+    /// a drop does.
+    pub fn free(self) {
+        match self {
+            Objects::Plain(e) => e.free(),
+            Objects::Sectored(e) => e.free(),
         }
     }
 

@@ -502,6 +502,17 @@ where
         }
     }
 
+    /// Frees the workers' objects, messages and records, each on its own thread: the thread
+    /// that allocated most of them, and a large run holds hundreds of megabytes.
+    pub fn free(mut self) {
+        let workers = std::mem::take(&mut self.workers);
+        std::thread::scope(|scope| {
+            for w in workers {
+                scope.spawn(move || drop(w));
+            }
+        });
+    }
+
     /// The model.
     pub fn model(&self) -> &M {
         &self.model
