@@ -956,9 +956,7 @@ impl<M: Model> Worker<M> {
         let mut run_final = self.final_ok && self.may_run_final(fabric, &time, to);
         if run_final {
             let here = Floor::of(&time, to);
-            if !self.lps[li].history.is_empty() {
-                self.commit_front(model, li, &here);
-            }
+            self.commit_front(model, li, &here);
             // a key deeper than a floor keeps may leave batches of the instant uncommitted
             run_final = self.lps[li].history.is_empty();
             if run_final {
@@ -1334,6 +1332,10 @@ impl<M: Model> Worker<M> {
 
     /// Commits the batches of local object `li` that `floor` passed, oldest first.
     fn commit_front(&mut self, model: &M, li: usize, floor: &Floor) {
+        // most objects have nothing uncommitted when they run a final batch
+        if self.lps[li].history.is_empty() {
+            return;
+        }
         let observed = self.ship && model.observed(self.lps[li].id);
         loop {
             let lp = &mut self.lps[li];
