@@ -266,6 +266,10 @@ pub struct Reduction {
     pub floor: Floor,
     /// Workers asked to stop (summed).
     pub stop: u64,
+    /// Workers whose heaps hold so many marked messages that they want them swept (summed):
+    /// all workers sweep in the same round, so that none waits at the next round for another
+    /// to finish its sweep.
+    pub sweep: u64,
 }
 
 impl Reduction {
@@ -275,6 +279,7 @@ impl Reduction {
             in_flight: self.in_flight + o.in_flight,
             floor: self.floor.min(o.floor),
             stop: self.stop + o.stop,
+            sweep: self.sweep + o.sweep,
         }
     }
 }
@@ -1260,8 +1265,9 @@ impl<M: Model> Worker<M> {
         m
     }
 
-    /// A GVT round: returns GVT (every batch before it is final).
-    fn gvt_round<F: Fabric<M>>(&mut self, fabric: &F, stop: bool) -> Result<Floor, Stop> {
+    /// A GVT round: returns the reduction over all workers, whose floor is GVT (every batch
+    /// before it is final).
+    fn gvt_round<F: Fabric<M>>(&mut self, fabric: &F, stop: bool) -> Result<Reduction, Stop> {
         let mut buf = Vec::new();
         loop {
             self.receive(fabric, &mut buf);
@@ -1270,6 +1276,7 @@ impl<M: Model> Worker<M> {
                 in_flight: self.sent_ops - self.received_ops,
                 floor: self.local_min(),
                 stop: u64::from(stop),
+                sweep: u64::from(self.marks.pending_marks() > self.heap.len() / 2 + 1024),
             };
             let g = fabric.reduce(self.index, local);
             if g.stop > 0 {
@@ -1277,7 +1284,7 @@ impl<M: Model> Worker<M> {
             }
             if g.in_flight == 0 {
                 self.stats.gvt_rounds += 1;
-                return Ok(g.floor);
+                return Ok(g);
             }
         }
     }
@@ -1383,8 +1390,15 @@ impl<M: Model> Worker<M> {
 
     /// Commits every batch before `gvt`: frees its saved state and messages, and returns what
     /// the collector needs of every batch committed so far that `gvt` passed (output, and
-    /// observed states when the collector wants them), in no particular order.
-    fn fossil_collect(&mut self, model: &M, gvt: Floor) -> Vec<Committed<M::State, M::Output>> {
+    /// observed states when the collector wants them), in no particular order. With `sweep`
+    /// (some worker wants its heap swept this round) drops the marked messages that are gone
+    /// for good from the heap, if they are a fair share of it.
+    fn fossil_collect(
+        &mut self,
+        model: &M,
+        gvt: Floor,
+        sweep: bool,
+    ) -> Vec<Committed<M::State, M::Output>> {
         let mut still = Vec::with_capacity(self.active.len());
         for k in 0..self.active.len() {
             let li = self.active[k] as usize;
@@ -1404,8 +1418,10 @@ impl<M: Model> Worker<M> {
         self.to_ship = later;
         self.marks.collect(gvt.t);
         // marked messages wait in the heap for their time; drop those that are gone for good
-        // when the marks outnumber the rest
-        if self.marks.pending_marks() > self.heap.len() / 2 + 1024 {
+        // when the marks outnumber the rest on some worker (this one's too, then), or are a
+        // quarter of the heap here: a sweep of a large heap takes tens of milliseconds, which
+        // the others would otherwise spend waiting at the next round
+        if sweep && self.marks.pending_marks() > self.heap.len() / 4 + 1024 {
             let marks = &mut self.marks;
             self.heap
                 .retain(|it| marks.keeps(it.uid, it.p.retractable, gvt.t));
@@ -1503,13 +1519,15 @@ impl<M: Model> Worker<M> {
                     )))
                 }
                 Err(s) => break Err(s),
-                Ok(gvt) => {
+                Ok(Reduction {
+                    floor: gvt, sweep, ..
+                }) => {
                     // without a set window, run at most a few rounds' worth of GVT progress ahead
                     if self.gvt.t.is_finite() && gvt.t.is_finite() && gvt.t > self.gvt.t {
                         self.auto_window = 4.0 * (gvt.t - self.gvt.t);
                     }
                     self.gvt = gvt;
-                    let batches = self.fossil_collect(model, gvt);
+                    let batches = self.fossil_collect(model, gvt, sweep > 0);
                     self.round += 1;
                     fabric.commit(Chunk {
                         worker: self.index,

@@ -201,7 +201,14 @@ where
             let mut g = here;
             world.all_reduce_into(&here.in_flight, &mut g.in_flight, SystemOperation::sum());
             g.floor = all_min(&world, here.floor);
-            world.all_reduce_into(&here.stop, &mut g.stop, SystemOperation::sum());
+            // stop requests and sweep requests in one reduction
+            let mut flags = [0u64; 2];
+            world.all_reduce_into(
+                &[here.stop, here.sweep][..],
+                &mut flags[..],
+                SystemOperation::sum(),
+            );
+            (g.stop, g.sweep) = (flags[0], flags[1]);
             *self.result.lock().expect("no thread panicked") = g;
         }
         self.barrier.wait();

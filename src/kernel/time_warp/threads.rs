@@ -14,6 +14,7 @@ pub const NOTHING: Reduction = Reduction {
     in_flight: 0,
     floor: Floor::INFINITY,
     stop: 0,
+    sweep: 0,
 };
 
 /// Reductions among the threads of one process: three rotating slots and a barrier.
