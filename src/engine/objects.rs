@@ -35,7 +35,7 @@ impl<M> Exec<M>
 where
     M: Model + Sync,
     M::Msg: Send,
-    M::State: Send,
+    M::State: Send + Sync,
     M::Output: Send,
 {
     /// The sequential executor, or Time Warp with `tw` and the objects' workers `worker_of`.
@@ -264,7 +264,7 @@ fn outcome<M>(e: &Exec<M>, table: &Table, until: f64, counts: EventCounts) -> Ou
 where
     M: Model + Sync,
     M::Msg: Send,
-    M::State: Send + BallOf,
+    M::State: Send + Sync + BallOf,
     M::Output: Send,
 {
     let view = View {

@@ -421,7 +421,7 @@ impl<M> TimeWarp<M>
 where
     M: Model + Sync,
     M::Msg: Send,
-    M::State: Send,
+    M::State: Send + Sync,
     M::Output: Send,
 {
     /// Places the objects on the workers of every rank (`worker_of[o]` for object `o`, below
@@ -438,33 +438,30 @@ where
         let per = cfg.workers.max(1);
         let placement = Arc::new(Placement::new(worker_of, per * ranks));
         let mine = rank * per..(rank + 1) * per;
-        // this rank's objects move to their workers, which copy them for the collector and run
-        // their `init`s on a thread each; the collector keeps the other ranks' objects as they are
-        let n = states.len();
-        let mut local: Vec<Vec<(u32, M::State)>> = (0..per).map(|_| Vec::new()).collect();
-        let mut kept: Vec<Option<M::State>> = Vec::with_capacity(n);
-        for (o, s) in states.into_iter().enumerate() {
-            let w = placement.worker(o as u32);
+        // the collector keeps every object's state as it starts; each of this rank's workers
+        // copies its own objects on a thread of its own and runs their `init`s there
+        let mut ids: Vec<Vec<u32>> = (0..per).map(|_| Vec::new()).collect();
+        for o in 0..states.len() as u32 {
+            let w = placement.worker(o);
             if mine.contains(&w) {
-                local[w - mine.start].push((o as u32, s));
-                kept.push(None);
-            } else {
-                kept.push(Some(s));
+                ids[w - mine.start].push(o);
             }
         }
-        let model_ref = &model;
-        let built: Vec<_> = std::thread::scope(|scope| {
-            let handles: Vec<_> = local
+        let (model_ref, states_ref) = (&model, &states);
+        let mut workers: Vec<Worker<M>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = ids
                 .into_iter()
                 .enumerate()
-                .map(|(k, st)| {
+                .map(|(k, ids)| {
                     let (placement, start) = (placement.clone(), &start);
                     scope.spawn(move || {
-                        let copies: Vec<(u32, M::State)> =
-                            st.iter().map(|(o, s)| (*o, s.clone())).collect();
-                        let mut w = Worker::new(mine.start + k, placement, st, cfg.chaos);
+                        let own: Vec<(u32, M::State)> = ids
+                            .into_iter()
+                            .map(|o| (o, states_ref[o as usize].clone()))
+                            .collect();
+                        let mut w = Worker::new(mine.start + k, placement, own, cfg.chaos);
                         w.init(model_ref, start);
-                        (w, copies)
+                        w
                     })
                 })
                 .collect();
@@ -473,17 +470,6 @@ where
                 .map(|h| h.join().expect("a worker's set-up does not panic"))
                 .collect()
         });
-        let mut workers = Vec::with_capacity(per);
-        for (w, copies) in built {
-            for (o, s) in copies {
-                kept[o as usize] = Some(s);
-            }
-            workers.push(w);
-        }
-        let states: Vec<M::State> = kept
-            .into_iter()
-            .map(|s| s.expect("every object kept or copied"))
-            .collect();
         // init's sends to this rank's workers are delivered here; others wait in outboxes
         let mut mail: Vec<Vec<Op<M::Msg>>> = (0..per).map(|_| Vec::new()).collect();
         for w in &mut workers {
