@@ -694,6 +694,38 @@ mod tests {
     }
 
     #[test]
+    fn every_worker_hears_of_a_sweep_one_of_them_wants() {
+        let reduce = ThreadReduce::new(3);
+        let wants = [0u64, 1, 0];
+        let heard: Vec<Reduction> = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..3)
+                .map(|me| {
+                    let reduce = &reduce;
+                    s.spawn(move || {
+                        // two rounds: the second, in which nobody wants one, says so
+                        let first = reduce.reduce(
+                            me,
+                            Reduction {
+                                sweep: wants[me],
+                                floor: Floor::start(me as f64),
+                                ..NOTHING
+                            },
+                        );
+                        let second = reduce.reduce(me, NOTHING);
+                        assert_eq!(second.sweep, 0, "a sweep is asked for one round");
+                        first
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        for r in heard {
+            assert_eq!(r.sweep, 1);
+            assert_eq!(r.floor, Floor::start(0.0));
+        }
+    }
+
+    #[test]
     fn a_floor_covers_what_workers_hold_and_what_waits_in_inboxes() {
         let (tx, _rx) = mpsc::channel();
         let f: ThreadFabric<Numbers> = ThreadFabric::new(3, tx);
