@@ -492,6 +492,12 @@ fn give<T>(pool: &mut Vec<Vec<T>>, mut v: Vec<T>) {
     }
 }
 
+/// A worker asks for a sweep of the heaps when marked messages are over half of its heap
+/// ([`Reduction::sweep`]).
+const ASK_SWEEP: usize = 2;
+/// A worker joins a sweep another asked for when they are over a quarter of its heap.
+const JOIN_SWEEP: usize = 4;
+
 /// A batch an object ran that is not committed yet.
 struct Done<M: Model> {
     time: VTime,
@@ -1265,6 +1271,12 @@ impl<M: Model> Worker<M> {
         m
     }
 
+    /// Whether the heap's marked messages are more than a `1 / share` of it (and more than a
+    /// few): the test for asking for a sweep ([`ASK_SWEEP`]) and for joining one ([`JOIN_SWEEP`]).
+    fn heap_marked_over(&self, share: usize) -> bool {
+        self.marks.pending_marks() > self.heap.len() / share + 1024
+    }
+
     /// A GVT round: returns the reduction over all workers, whose floor is GVT (every batch
     /// before it is final).
     fn gvt_round<F: Fabric<M>>(&mut self, fabric: &F, stop: bool) -> Result<Reduction, Stop> {
@@ -1276,7 +1288,7 @@ impl<M: Model> Worker<M> {
                 in_flight: self.sent_ops - self.received_ops,
                 floor: self.local_min(),
                 stop: u64::from(stop),
-                sweep: u64::from(self.marks.pending_marks() > self.heap.len() / 2 + 1024),
+                sweep: u64::from(self.heap_marked_over(ASK_SWEEP)),
             };
             let g = fabric.reduce(self.index, local);
             if g.stop > 0 {
@@ -1421,7 +1433,7 @@ impl<M: Model> Worker<M> {
         // when the marks outnumber the rest on some worker (this one's too, then), or are a
         // quarter of the heap here: a sweep of a large heap takes tens of milliseconds, which
         // the others would otherwise spend waiting at the next round
-        if sweep && self.marks.pending_marks() > self.heap.len() / 4 + 1024 {
+        if sweep && self.heap_marked_over(JOIN_SWEEP) {
             let marks = &mut self.marks;
             self.heap
                 .retain(|it| marks.keeps(it.uid, it.p.retractable, gvt.t));
