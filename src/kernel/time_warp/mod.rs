@@ -308,7 +308,9 @@ pub struct Chunk<S, O> {
     pub batches: Vec<Committed<S, O>>,
     /// Set on the worker's last chunk of a run: its statistics.
     pub last: Option<(TwStats, MessageStats, u64)>,
-    /// On the last chunk of a run that ended well: the worker's objects' final states.
+    /// On the last chunk of a run that ended well, from a worker whose collector runs in
+    /// another process: the worker's objects' final states. (Workers beside their collector
+    /// hand theirs over in place: [`Worker::swap_states`].)
     pub finals: Vec<(u32, S)>,
     /// Set when the worker stopped on an error.
     pub error: Option<String>,
@@ -343,6 +345,11 @@ pub trait Fabric<M: Model>: Sync {
     /// batches faster (final ones) does not wait there for the others to run as many.
     fn round_due(&self, _me: usize, _done: u64, due: bool) -> bool {
         due
+    }
+    /// Whether the collector runs in this process, where the workers hand it their final
+    /// states in place after the run instead of copying them into their last chunks.
+    fn collector_is_local(&self) -> bool {
+        true
     }
 }
 
@@ -758,6 +765,23 @@ impl<M: Model> Worker<M> {
     /// a look-up per message, 20 ms at the end of a 10^5-ball run.)
     pub fn pending_len(&self) -> usize {
         self.heap.len() + self.marks.set_aside_len()
+    }
+
+    /// Exchanges each of this worker's objects' states with its entry in `states` (indexed by
+    /// object): after a run, a collector beside the workers takes the final states this way,
+    /// moving them rather than copying them; the workers get them back with
+    /// [`Worker::restore_states`] before they run again.
+    pub fn swap_states(&mut self, states: &mut [M::State]) {
+        for lp in &mut self.lps {
+            std::mem::swap(&mut lp.state, &mut states[lp.id as usize]);
+        }
+    }
+
+    /// Sets each of this worker's objects' states to a copy of its entry in `states`.
+    pub fn restore_states(&mut self, states: &[M::State]) {
+        for lp in &mut self.lps {
+            lp.state = states[lp.id as usize].clone();
+        }
     }
 
     /// Memory samples (uncommitted batches plus held messages) after each GVT round.
@@ -1572,7 +1596,7 @@ impl<M: Model> Worker<M> {
                 std::mem::take(&mut self.committed_stats),
                 self.pending_len() as u64,
             )),
-            finals: if result.is_ok() {
+            finals: if result.is_ok() && !fabric.collector_is_local() {
                 self.lps
                     .iter()
                     .map(|lp| (lp.id, lp.state.clone()))

@@ -215,6 +215,10 @@ where
         *self.result.lock().expect("no thread panicked")
     }
 
+    fn collector_is_local(&self) -> bool {
+        self.rank == 0
+    }
+
     fn commit(&self, chunk: Chunk<M::State, M::Output>) {
         if self.rank == 0 {
             self.deliver(Parcel::Chunk(Box::new(chunk)));

@@ -392,6 +392,9 @@ pub struct TimeWarp<M: Model> {
     cfg: TwConfig,
     collector: Collector<M>,
     ranks: usize,
+    /// Whether the workers handed their final states to the collector after the last run
+    /// (holding the collector's old ones in their place).
+    handed_over: bool,
 }
 
 /// This process's MPI rank and the number of ranks; `(0, 1)` without MPI.
@@ -486,6 +489,7 @@ where
             cfg,
             collector: Collector::new(states),
             ranks,
+            handed_over: false,
         }
     }
 
@@ -545,6 +549,11 @@ where
     /// each output, with the committed states just after its batch, in the sequential order
     /// (on rank 0 only, under MPI).
     pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), TwError<E>> {
+        if std::mem::take(&mut self.handed_over) {
+            for w in &mut self.workers {
+                w.restore_states(&self.collector.states);
+            }
+        }
         let (tx, rx) = mpsc::channel();
         let mut failed: Option<TwError<E>> = None;
         self.collector.stats = TwStats::default();
@@ -574,6 +583,13 @@ where
                         .take(&self.model, total, chunk, sink, &mut failed);
                 }
             }
+        }
+        // the workers of the collecting process hand their final states over in place
+        if failed.is_none() && collects_results() {
+            for w in &mut self.workers {
+                w.swap_states(&mut self.collector.states);
+            }
+            self.handed_over = true;
         }
         match failed {
             Some(e) => Err(e),
@@ -873,5 +889,39 @@ mod tests {
             "the output saw the states of its round"
         );
         assert_eq!(c.states(), &[9, 8], "and the final states came after it");
+    }
+
+    #[test]
+    fn a_run_taken_up_again_ends_where_one_run_ends() {
+        use crate::kernel::sequential::Sequential;
+        use crate::model::phold::{Phold, PholdConfig};
+        let cfg = PholdConfig {
+            objects: 64,
+            events_per_object: 4,
+            remote: 0.3,
+            partitions: 2,
+            lookahead: 0.0,
+            mean: 1.0,
+            seed: 3,
+        };
+        let (model, states) = Phold::new(cfg.clone());
+        let mut seq = Sequential::new(model, states, at(0.0));
+        seq.run::<()>(20.0, &mut |_, _, _| Ok(())).unwrap();
+        let (model, states) = Phold::new(cfg);
+        let worker_of: Vec<u32> = (0..64).map(|o| model.partition(o)).collect();
+        let tw_cfg = TwConfig {
+            workers: 2,
+            ..TwConfig::default()
+        };
+        let mut tw = TimeWarp::new(model, states, at(0.0), &worker_of, tw_cfg);
+        tw.run::<()>(7.0, &mut |_, _, _| Ok(())).unwrap();
+        let halfway: Vec<u64> = tw.states().iter().map(|s| s.handled).collect();
+        assert!(halfway.iter().sum::<u64>() > 0, "the first leg ran");
+        // the workers handed their states to the collector and take them back to go on
+        tw.run::<()>(20.0, &mut |_, _, _| Ok(())).unwrap();
+        let json = |s| serde_json::to_string(s).unwrap();
+        assert_eq!(json(seq.states()), json(tw.states()));
+        let handled: Vec<u64> = tw.states().iter().map(|s| s.handled).collect();
+        assert_ne!(halfway, handled, "the second leg ran");
     }
 }
