@@ -198,13 +198,15 @@ impl Objects {
     }
 
     /// Sets the sectored objects up, sequential or (with `tw`) under Time Warp, each sector and
-    /// the balls that start in it on one worker.
+    /// the balls that start in it on one worker; Time Warp builds the model on as many threads
+    /// as it has workers here.
     pub fn sectored_on(s: &Scenario, layout: Layout, span: Span, tw: Option<TwConfig>) -> Objects {
+        let threads = tw.as_ref().map_or(1, |c| c.workers.max(1));
         let tw = tw.map(|c| {
             let w = partition::sectored(s, &layout, total_workers(&c));
             (c, w)
         });
-        let (model, states) = Sectored::new(s, layout, span);
+        let (model, states) = Sectored::new(s, layout, span, threads);
         Objects::Sectored(Exec::new(model, states, span.start, tw))
     }
 

@@ -36,7 +36,7 @@ use crate::geometry::{Trajectory, Vec2};
 use crate::kernel::{Ctx, Envelope, Model, SentPair, VTime};
 use crate::physics::{self, Contact};
 use crate::polygon::{self, Polygon};
-use crate::scenario::Scenario;
+use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, DEPARTURE, REVERSAL};
 use smallvec::SmallVec;
 use std::sync::Arc;
@@ -380,40 +380,68 @@ pub struct Sectored {
 
 impl Sectored {
     /// The model and initial states of a validated scenario over `layout`, starting at
-    /// `span.start` (frames are not drawn here).
-    pub fn new(s: &Scenario, layout: Layout, span: Span) -> (Sectored, Vec<SecState>) {
+    /// `span.start` (frames are not drawn here); the balls' sectors are found on `threads`
+    /// threads (Time Warp builds its model with as many as it has workers).
+    pub fn new(
+        s: &Scenario,
+        layout: Layout,
+        span: Span,
+        threads: usize,
+    ) -> (Sectored, Vec<SecState>) {
         let table = Table::new(s);
         let n = table.n_balls;
         let first_sector = n + table.n_fixed();
-        let mut members: Vec<Vec<(u32, u64)>> = vec![Vec::new(); layout.polys.len()];
-        let mut states: Vec<SecState> = Vec::new();
-        for (i, b) in s.balls.iter().enumerate() {
-            let info = Arc::new(BallInfo {
-                traj: Trajectory {
-                    position: b.position,
-                    velocity: b.velocity,
-                    t0: span.start,
-                },
-                radius: b.radius,
-                mass: b.mass,
-                fixed: Key::start(span.start),
-                version: 0,
-                pocket: None,
-            });
-            let sectors: Sectors = layout
-                .touching(b.position, b.radius)
-                .into_iter()
-                .map(|k| {
-                    members[k as usize].push((i as u32, info.version));
-                    first_sector + k
+        let balls = |specs: &[BallSpec]| -> Vec<SecState> {
+            specs
+                .iter()
+                .map(|b| SecState::Ball {
+                    info: Arc::new(BallInfo {
+                        traj: Trajectory {
+                            position: b.position,
+                            velocity: b.velocity,
+                            t0: span.start,
+                        },
+                        radius: b.radius,
+                        mass: b.mass,
+                        fixed: Key::start(span.start),
+                        version: 0,
+                        pocket: None,
+                    }),
+                    planned: Vec::new(),
+                    sectors: layout
+                        .touching(b.position, b.radius)
+                        .into_iter()
+                        .map(|k| first_sector + k)
+                        .collect(),
+                    awaiting: Vec::new(),
                 })
-                .collect();
-            states.push(SecState::Ball {
-                info,
-                planned: Vec::new(),
-                sectors,
-                awaiting: Vec::new(),
+                .collect()
+        };
+        let objects = first_sector as usize + layout.polys.len();
+        let mut states: Vec<SecState> = Vec::with_capacity(objects);
+        let chunk = s.balls.len().div_ceil(threads.max(1)).max(1);
+        if threads > 1 && s.balls.len() > chunk {
+            let balls = &balls;
+            std::thread::scope(|scope| {
+                let parts: Vec<_> = s
+                    .balls
+                    .chunks(chunk)
+                    .map(|c| scope.spawn(move || balls(c)))
+                    .collect();
+                for p in parts {
+                    states.extend(p.join().expect("finding sectors does not panic"));
+                }
             });
+        } else {
+            states.extend(balls(&s.balls));
+        }
+        let mut members: Vec<Vec<(u32, u64)>> = vec![Vec::new(); layout.polys.len()];
+        for (i, st) in states.iter().enumerate() {
+            if let SecState::Ball { info, sectors, .. } = st {
+                for &k in sectors {
+                    members[(k - first_sector) as usize].push((i as u32, info.version));
+                }
+            }
         }
         for _ in 0..table.n_fixed() {
             states.push(SecState::Fixed {
