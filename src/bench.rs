@@ -365,8 +365,8 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             a.tw_until
         );
         println!(
-            "{:>9} {:>8} {:>9} {:>9} {:>11} {:>8} {:>6}  digest",
-            "balls", "workers", "wall s", "speed-up", "efficiency", "remote", "final"
+            "{:>9} {:>8} {:>9} {:>9} {:>9} {:>11} {:>8} {:>6}  digest",
+            "balls", "workers", "wall s", "set-up s", "speed-up", "efficiency", "remote", "final"
         );
     }
     let mut time_warp = Vec::new();
@@ -379,7 +379,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         for r in rows {
             if !a.json {
                 println!(
-                    "{:>9} {:>8} {:>9.3} {:>9.2} {:>11.3} {:>8.3} {:>6.3}  {}",
+                    "{:>9} {:>8} {:>9.3} {:>9.3} {:>9.2} {:>11.3} {:>8.3} {:>6.3}  {}",
                     r.balls,
                     if r.workers == 0 {
                         "seq".to_string()
@@ -387,6 +387,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                         r.workers.to_string()
                     },
                     r.seconds,
+                    r.setup_seconds,
                     r.speedup,
                     r.efficiency,
                     r.remote_fraction,
@@ -544,6 +545,8 @@ pub struct TwRow {
     pub workers: usize,
     /// Wall seconds, set-up included.
     pub seconds: f64,
+    /// Of those, the set-up's: building the model and running the objects' `init`s.
+    pub setup_seconds: f64,
     /// The sequential run's seconds over this run's.
     pub speedup: f64,
     /// Physical events.
@@ -619,6 +622,7 @@ fn time_warp_rows(balls: usize, until: f64, pure: bool) -> Result<Vec<TwRow>, St
             until,
             workers,
             seconds,
+            setup_seconds: report.setup_seconds,
             speedup: rows.first().map_or(1.0, |r| r.seconds / seconds),
             events: report.outcome.events.total(),
             efficiency: tw["efficiency"].as_f64().unwrap_or(1.0),

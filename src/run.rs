@@ -122,6 +122,9 @@ pub struct Report {
     pub outcome: Outcome,
     /// Wall-clock seconds spent in the engine (setup included).
     pub wall_seconds: f64,
+    /// Of those, the seconds before the first event: building the engine and setting its
+    /// objects up (their `init`s included).
+    pub setup_seconds: f64,
     /// The largest relative energy drift the checker saw, when checking.
     pub max_energy_drift: Option<f64>,
     /// The run summary (`--json`).
@@ -204,6 +207,8 @@ pub fn execute(
         .then(|| Checker::new(&initial, table.is_elastic()));
     let mut sinks = Sinks { checker, user: obs };
     let mut time_warp: Option<TwStats> = None;
+    // the engine built and its objects set up, before the first event
+    let setup;
     let outcome = match cfg.engine {
         EngineKind::EventList => {
             let opts = event_list::Options {
@@ -211,6 +216,7 @@ pub fn execute(
                 ..Default::default()
             };
             let mut e = EventList::new(scenario, opts);
+            setup = start.elapsed().as_secs_f64();
             e.run(cfg.until, &mut sinks)?
         }
         EngineKind::TimeStep { dt } => {
@@ -223,10 +229,12 @@ pub fn execute(
                 )));
             }
             let mut e = TimeStep::new(scenario, time_step::Options { dt, span: cfg.span });
+            setup = start.elapsed().as_secs_f64();
             e.run(cfg.until, &mut sinks)?
         }
         EngineKind::Objects { delay } => {
             let mut e = Objects::new(scenario, delay, cfg.span);
+            setup = start.elapsed().as_secs_f64();
             e.run(cfg.until, &mut sinks)?
         }
         EngineKind::Sectored { sectors, news } => {
@@ -238,6 +246,7 @@ pub fn execute(
             let mut layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
             layout.fixed_news = news;
             let mut e = Objects::sectored(scenario, layout, cfg.span);
+            setup = start.elapsed().as_secs_f64();
             e.run(cfg.until, &mut sinks)?
         }
         EngineKind::TimeWarp {
@@ -259,6 +268,7 @@ pub fn execute(
                     Objects::sectored_on(scenario, layout, cfg.span, Some(tw))
                 }
             };
+            setup = start.elapsed().as_secs_f64();
             let out = e.run(cfg.until, &mut sinks)?;
             time_warp = e.tw_stats();
             e.free();
@@ -295,6 +305,7 @@ pub fn execute(
         },
         "final_state_digest": digest(outcome.t, &outcome.balls),
         "wall_seconds": wall,
+        "setup_seconds": setup,
         "events_per_second": if wall > 0.0 { n_events as f64 / wall } else { 0.0 },
         "checked": cfg.check,
         "engine_stats": stats,
@@ -306,6 +317,7 @@ pub fn execute(
     Ok(Report {
         outcome,
         wall_seconds: wall,
+        setup_seconds: setup,
         max_energy_drift: max_drift,
         summary,
     })

@@ -140,6 +140,7 @@ fn run_json_prints_one_summary_object_and_nothing_on_stderr() {
         "kinetic_energy",
         "final_state_digest",
         "wall_seconds",
+        "setup_seconds",
         "events_per_second",
     ] {
         assert!(v.get(key).is_some(), "no {key} in {v}");
@@ -162,7 +163,8 @@ fn run_json_prints_one_summary_object_and_nothing_on_stderr() {
     let digest = v["final_state_digest"].as_str().expect("a string digest");
     assert_eq!(digest.len(), 16, "{digest}");
     assert!(digest.chars().all(|c| c.is_ascii_hexdigit()), "{digest}");
-    assert!(f(&v["wall_seconds"]) >= 0.0);
+    assert!(f(&v["wall_seconds"]) >= f(&v["setup_seconds"]));
+    assert!(f(&v["setup_seconds"]) >= 0.0);
     assert!(f(&v["events_per_second"]) >= 0.0);
 }
 
