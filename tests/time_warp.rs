@@ -378,6 +378,13 @@ fn batches_run_as_final_beside_optimistic_ones() {
         finals < committed,
         "every batch ran as final on 2 workers: {tw}"
     );
+    // the set-up instant's relays, which no one can cancel, run as final against the other
+    // worker's next generation
+    let uncancellable = tw["final_uncancellable"].as_u64().unwrap();
+    assert!(
+        uncancellable > 0 && uncancellable <= finals,
+        "{uncancellable} final by generation: {tw}"
+    );
     // optimistic batches are committed as soon as nothing can undo them, not only at rounds
     let early = tw["committed_early"].as_u64().unwrap();
     assert!(

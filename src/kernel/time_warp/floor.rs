@@ -82,6 +82,20 @@ impl Floor {
             .then(self.to.cmp(&to))
     }
 
+    /// Below every message a worker standing at this floor may still send: a send is later
+    /// than its batch, at least the next generation of the batch's key. A floor cut from a
+    /// deeper key, or that may have been, and an infinite one stay as they are.
+    pub fn next_generation(self) -> Floor {
+        if !self.t.is_finite() || usize::from(self.len) == DEPTH {
+            return self;
+        }
+        Floor {
+            gen: self.gen.saturating_add(1),
+            to: 0,
+            ..self
+        }
+    }
+
     /// The smaller of two floors.
     pub fn min(self, o: Floor) -> Floor {
         if o < self {
@@ -168,6 +182,18 @@ mod tests {
         assert!(f.passed(&vtime(3.0, &path[..DEPTH - 1], 9), 9));
     }
 
+    #[test]
+    fn the_next_generation_is_below_every_later_virtual_time() {
+        let f = Floor::of(&vtime(2.0, &[pair(1, 2)], 3), 7);
+        let g = f.next_generation();
+        assert!(!g.passed(&vtime(2.0, &[pair(1, 2)], 4), 0));
+        assert!(g.passed(&vtime(2.0, &[pair(1, 2)], 3), u32::MAX));
+        let deep: Vec<u64> = (1..=6).map(|k| pair(k, k + 1)).collect();
+        let cut = Floor::of(&vtime(2.0, &deep, 3), 7);
+        assert_eq!(cut.next_generation(), cut);
+        assert_eq!(Floor::INFINITY.next_generation(), Floor::INFINITY);
+    }
+
     fn arb_vtime() -> impl Strategy<Value = VTime> {
         (-2i32..3, prop::collection::vec(0u64..4, 0..7), 0u32..3)
             .prop_map(|(t, path, gen)| vtime(f64::from(t), &path, gen))
@@ -187,6 +213,10 @@ mod tests {
                 prop_assert_eq!(f.passed(&b, tb), before);
             }
             prop_assert_eq!(Floor::from_words(&f.to_words()), f);
+            // every virtual time after `a` is at or past the floor's next generation
+            if b > a {
+                prop_assert!(!f.next_generation().passed(&b, tb));
+            }
         }
     }
 }

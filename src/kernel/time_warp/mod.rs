@@ -126,6 +126,10 @@ pub struct TwStats {
     /// Of them, batches run as final: before every op another worker could still send, so
     /// without saving state (counted in `processed` too).
     pub final_batches: u64,
+    /// Of them, batches run as final only because no message could still reach them: none of
+    /// their messages can be cancelled, and every other worker stood at their virtual time or
+    /// later, so that its sends come at least a generation after them.
+    pub final_uncancellable: u64,
     /// Of the others, batches committed between GVT rounds, as soon as nothing could undo
     /// them any more (threads only).
     pub committed_early: u64,
@@ -171,6 +175,7 @@ impl TwStats {
         self.processed += o.processed;
         self.committed += o.committed;
         self.final_batches += o.final_batches;
+        self.final_uncancellable += o.final_uncancellable;
         self.committed_early += o.committed_early;
         self.rolled_back += o.rolled_back;
         self.rollbacks += o.rollbacks;
@@ -316,6 +321,17 @@ pub struct Chunk<S, O> {
     pub error: Option<String>,
 }
 
+/// What other workers may still send one worker, as [`Fabric::peers_floor`] reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// Below every op: the other workers' floors and every op waiting in an inbox.
+    pub any: Floor,
+    /// Below every message and anti-message, cancellations aside: a worker standing at a
+    /// floor sends those only from the floor's next generation on
+    /// ([`Floor::next_generation`]), and ops waiting for the asking worker come where they are.
+    pub messages: Floor,
+}
+
 /// How workers reach each other: delivery of ops, reductions and the collector.
 pub trait Fabric<M: Model>: Sync {
     /// Sends ops to worker `to`.
@@ -334,9 +350,9 @@ pub trait Fabric<M: Model>: Sync {
     /// Publishes a floor below everything worker `me` holds or has yet to send (taking ops
     /// from its inbox lowers it to theirs).
     fn publish(&self, _me: usize, _floor: Floor) {}
-    /// A floor below every op another worker may still send worker `me`, when the fabric can
-    /// tell: the published floors and the ops waiting in inboxes, read at one instant.
-    fn peers_floor(&self, _me: usize) -> Option<Floor> {
+    /// Floors below what other workers may still send worker `me`, when the fabric can tell:
+    /// the published floors and the ops waiting in inboxes, read at one instant.
+    fn peers_floor(&self, _me: usize) -> Option<Bounds> {
         None
     }
     /// Whether worker `me`, with `done` GVT rounds behind it, starts a round now: when it is
@@ -636,10 +652,15 @@ pub struct Worker<M: Model> {
     /// Below every op another worker may still send here, as last found (lowered by every op
     /// this worker sends away since).
     final_bound: Floor,
+    /// Below every message and anti-message another worker may still send here, likewise.
+    message_bound: Floor,
     /// Batches to wait before asking the fabric for a new bound after a failed try.
     bound_wait: u32,
-    /// The last batch run as final: no op may come at or before it.
+    /// The last batch run as final: no message or anti-message may come at or before it.
     final_floor: Floor,
+    /// The last batch run as final below every op another worker may send: no op at all, a
+    /// cancellation included, may come at or before it.
+    cancel_floor: Floor,
     /// The latest batch run optimistically: no uncommitted batch is later.
     high: Option<VTime>,
     /// Below every op in the outboxes.
@@ -714,8 +735,10 @@ impl<M: Model> Worker<M> {
             final_ok: false,
             ship: false,
             final_bound: Floor::NEG_INFINITY,
+            message_bound: Floor::NEG_INFINITY,
             bound_wait: 0,
             final_floor: Floor::NEG_INFINITY,
+            cancel_floor: Floor::NEG_INFINITY,
             high: None,
             outbox_floor: Floor::INFINITY,
             to_ship: Vec::new(),
@@ -801,6 +824,7 @@ impl<M: Model> Worker<M> {
             let f = op.floor();
             self.outbox_floor = self.outbox_floor.min(f);
             self.final_bound = self.final_bound.min(f);
+            self.message_bound = self.message_bound.min(f);
             self.outbox[w].push(op);
         }
     }
@@ -815,7 +839,12 @@ impl<M: Model> Worker<M> {
     /// should have seen.
     fn apply(&mut self, op: Op<M::Msg>) {
         let (to, (time, obj)) = (op.to(), op.place());
-        if self.final_floor.reaches(time, obj) {
+        // a cancellation may come before a batch of messages no one can cancel run as final
+        let floor = match op {
+            Op::Msg { .. } | Op::Anti { .. } => &self.final_floor,
+            Op::Cancel { .. } | Op::Retract { .. } => &self.cancel_floor,
+        };
+        if floor.reaches(time, obj) {
             self.fault.get_or_insert(format!(
                 "time warp: an op for object {to} at t = {} came after a later batch ran as final",
                 time.t()
@@ -931,33 +960,55 @@ impl<M: Model> Worker<M> {
         }
     }
 
-    /// Whether the batch of `to` at `time` may run as final: no op another worker may still
-    /// send, none this worker holds back (chaos) and none waiting in its outboxes comes at or
-    /// before it. Asks the fabric again only when the last bound does not answer and a few
-    /// batches have passed since the last try.
-    fn may_run_final<F: Fabric<M>>(&mut self, fabric: &F, time: &VTime, to: u32) -> bool {
+    /// Whether the batch of `to` at `time` may run as final, by the bounds last found: as
+    /// `Some(true)` when every op another worker may still send comes after it, as
+    /// `Some(false)` when every message does and no op can change the batch anyway, because
+    /// none of its messages can be cancelled (`cancellable` false).
+    fn final_by_bounds(&self, time: &VTime, to: u32, cancellable: bool) -> Option<bool> {
         if self.final_bound.passed(time, to) {
-            return true;
+            Some(true)
+        } else if !cancellable && self.message_bound.passed(time, to) {
+            Some(false)
+        } else {
+            None
+        }
+    }
+
+    /// Whether the batch of `to` at `time` may run as final ([`Worker::final_by_bounds`]): no
+    /// op (or, for a batch of messages no one can cancel, no message) another worker may still
+    /// send, none this worker holds back (chaos) and none waiting in its outboxes comes at or
+    /// before it. Asks the fabric again only when the last bounds do not answer and a few
+    /// batches have passed since the last try.
+    fn may_run_final<F: Fabric<M>>(
+        &mut self,
+        fabric: &F,
+        time: &VTime,
+        to: u32,
+        cancellable: bool,
+    ) -> Option<bool> {
+        if let Some(by) = self.final_by_bounds(time, to, cancellable) {
+            return Some(by);
         }
         if self.bound_wait > 0 {
             self.bound_wait -= 1;
-            return false;
+            return None;
         }
         if let Some(peers) = fabric.peers_floor(self.index) {
-            let mut b = peers.min(self.outbox_floor);
+            let mut own = self.outbox_floor;
             if let Some(c) = &self.chaos {
                 for (_, op) in &c.held {
-                    b = b.min(op.floor());
+                    own = own.min(op.floor());
                 }
             }
-            self.final_bound = b;
+            self.final_bound = peers.any.min(own);
+            self.message_bound = peers.messages.min(own);
         }
-        let ok = self.final_bound.passed(time, to);
-        if !ok {
+        let by = self.final_by_bounds(time, to, cancellable);
+        if by.is_none() {
             // each try locks every worker's slot twice
             self.bound_wait = self.placement.workers() as u32 - 1;
         }
-        ok
+        by
     }
 
     /// Runs the next batch if its time is at most `limit` (and, when `final_only`, if it may
@@ -972,7 +1023,9 @@ impl<M: Model> Worker<M> {
             let (time, to) = (top.p.time.clone(), top.p.to);
             // the first batch left at the last GVT round runs regardless: no floor ever passes
             // a key deeper than it keeps
-            if Floor::of(&time, to) > self.gvt && !self.may_run_final(fabric, &time, to) {
+            if Floor::of(&time, to) > self.gvt
+                && self.may_run_final(fabric, &time, to, true).is_none()
+            {
                 return false;
             }
         }
@@ -986,29 +1039,11 @@ impl<M: Model> Worker<M> {
             self.last_time(li).is_none_or(|t| *t < time),
             "batches run in order"
         );
-        // a batch before everything still to come is final, and so are the object's earlier
-        // ones: commit those, and run this one without saving the state
-        let mut run_final = self.final_ok && self.may_run_final(fabric, &time, to);
-        if run_final {
-            let here = Floor::of(&time, to);
-            self.commit_front(model, li, &here);
-            // a key deeper than a floor keeps may leave batches of the instant uncommitted
-            run_final = self.lps[li].history.is_empty();
-            if run_final {
-                self.final_floor = here;
-            }
-        }
-        // a batch run as final is never put back, so it keeps no names of its messages
-        let mut inputs = if run_final {
-            Vec::new()
-        } else {
-            take(&mut self.spare.inputs)
-        };
+        let mut inputs = take(&mut self.spare.inputs);
         let mut batch = take(&mut self.spare.batches);
+        let mut cancellable = first.p.retractable;
         let (input, env) = first.into_input();
-        if !run_final {
-            inputs.push(input);
-        }
+        inputs.push(input);
         batch.push(env);
         while let Some(top) = self.heap.peek() {
             if top.p.time != time || top.p.to != to {
@@ -1017,13 +1052,36 @@ impl<M: Model> Worker<M> {
             let it = self.heap.pop().expect("a top");
             match self.marks.of(it.uid, it.p.retractable) {
                 Mark::Live => {
+                    cancellable |= it.p.retractable;
                     let (input, env) = it.into_input();
-                    if !run_final {
-                        inputs.push(input);
-                    }
+                    inputs.push(input);
                     batch.push(env);
                 }
                 mark => self.marks.set_aside(it.uid, it.p, mark, self.gvt.t),
+            }
+        }
+        // a batch before everything still to come is final, and so are the object's earlier
+        // ones: commit those, and run this one without saving the state
+        let by = if self.final_ok {
+            self.may_run_final(fabric, &time, to, cancellable)
+        } else {
+            None
+        };
+        let mut run_final = by.is_some();
+        if run_final {
+            let here = Floor::of(&time, to);
+            self.commit_front(model, li, &here);
+            // a key deeper than a floor keeps may leave batches of the instant uncommitted
+            run_final = self.lps[li].history.is_empty();
+            if run_final {
+                self.final_floor = here;
+                if by == Some(true) {
+                    self.cancel_floor = here;
+                } else {
+                    self.stats.final_uncancellable += 1;
+                }
+                // a batch run as final is never put back, so it keeps no names of its messages
+                inputs.clear();
             }
         }
         // the next batch's object, most likely: its record loads while this batch runs
@@ -1054,6 +1112,7 @@ impl<M: Model> Worker<M> {
             self.stats.final_batches += 1;
             let delivered = batch.len();
             give(&mut self.spare.batches, batch);
+            give(&mut self.spare.inputs, inputs);
             let did = Did {
                 time,
                 uids: first,

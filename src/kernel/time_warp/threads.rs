@@ -2,7 +2,9 @@
 //! the executor that runs one thread per worker while the calling thread collects committed
 //! batches and feeds them, in order, to the sink.
 
-use super::{Chunk, Committed, Fabric, Floor, Op, Placement, Reduction, TwConfig, TwStats, Worker};
+use super::{
+    Bounds, Chunk, Committed, Fabric, Floor, Op, Placement, Reduction, TwConfig, TwStats, Worker,
+};
 use crate::kernel::sequential::Sink;
 use crate::kernel::{MessageStats, Model, VTime};
 use std::collections::BTreeMap;
@@ -230,16 +232,18 @@ where
         slot.floors.write(floor, waiting);
     }
 
-    fn peers_floor(&self, me: usize) -> Option<Floor> {
+    fn peers_floor(&self, me: usize) -> Option<Bounds> {
         // an op is always under some floor: in its sender's until it is in an inbox, in the
-        // inbox's until its receiver takes it, and in its receiver's from then on
-        let (mut changes, mut floor) = (0u64, Floor::INFINITY);
+        // inbox's until its receiver takes it, and in its receiver's from then on; what waits
+        // for another worker reaches `me` only through what that worker does from there
+        let (mut changes, mut others, mut mine) = (0u64, Floor::INFINITY, Floor::INFINITY);
         for (w, slot) in self.slots.iter().enumerate() {
             let (seq, own, waiting) = slot.floors.read()?;
             changes += seq;
-            floor = floor.min(waiting);
-            if w != me {
-                floor = floor.min(own);
+            if w == me {
+                mine = waiting;
+            } else {
+                others = others.min(own).min(waiting);
             }
         }
         // counts only grow: the same sum on a second reading means no slot changed between
@@ -249,7 +253,10 @@ where
             .iter()
             .map(|slot| slot.floors.seq.load(Ordering::Acquire))
             .sum();
-        (again == changes).then_some(floor)
+        (again == changes).then_some(Bounds {
+            any: others.min(mine),
+            messages: others.next_generation().min(mine),
+        })
     }
 }
 
@@ -746,14 +753,20 @@ mod tests {
         let (tx, _rx) = mpsc::channel();
         let f: ThreadFabric<Numbers> = ThreadFabric::new(3, tx);
         assert!(Fabric::shares_floors(&f));
+        let any = |me| f.peers_floor(me).map(|b| b.any);
+        let messages = |me| f.peers_floor(me).map(|b| b.messages);
         // a worker that has published nothing covers nothing
-        assert_eq!(f.peers_floor(0), Some(Floor::NEG_INFINITY));
+        assert_eq!(any(0), Some(Floor::NEG_INFINITY));
         f.publish(0, Floor::start(9.0));
         f.publish(1, Floor::start(5.0));
         f.publish(2, Floor::start(7.0));
-        assert_eq!(f.peers_floor(0), Some(Floor::start(5.0)));
+        assert_eq!(any(0), Some(Floor::start(5.0)));
+        // messages come a generation after the lowest floor at the earliest
+        let next = Floor::start(5.0).next_generation();
+        assert_eq!(messages(0), Some(next));
+        assert!(next > Floor::start(5.0) && !next.passed(&at(5.0).next_gen(), 0));
         assert_eq!(
-            f.peers_floor(1),
+            any(1),
             Some(Floor::start(7.0)),
             "a worker's own floor is not its bound"
         );
@@ -765,17 +778,23 @@ mod tests {
         };
         f.send(1, 2, vec![anti(3.0)]);
         f.publish(1, Floor::start(8.0));
-        assert_eq!(f.peers_floor(0), Some(Floor::of(&at(3.0), 9)));
+        assert_eq!(any(0), Some(Floor::of(&at(3.0), 9)));
+        assert_eq!(messages(0), Some(Floor::of(&at(3.0), 9).next_generation()));
         // worker 2 takes it: its own floor drops to the op's until it publishes again
         let mut got = Vec::new();
         f.recv(2, &mut got);
         assert_eq!(got.len(), 1);
-        assert_eq!(f.peers_floor(0), Some(Floor::of(&at(3.0), 9)));
+        assert_eq!(any(0), Some(Floor::of(&at(3.0), 9)));
         f.publish(2, Floor::start(6.0));
-        assert_eq!(f.peers_floor(0), Some(Floor::start(6.0)));
+        assert_eq!(any(0), Some(Floor::start(6.0)));
         // an op waiting for the asking worker itself bounds it too
         f.send(2, 0, vec![anti(4.0)]);
-        assert_eq!(f.peers_floor(0), Some(Floor::of(&at(4.0), 9)));
+        assert_eq!(any(0), Some(Floor::of(&at(4.0), 9)));
+        assert_eq!(
+            messages(0),
+            Some(Floor::of(&at(4.0), 9)),
+            "an op waiting for the asking worker bounds it where it is"
+        );
     }
 
     /// The threads' fabric, but claiming that nothing can ever come: every batch runs final.
@@ -802,8 +821,11 @@ mod tests {
         fn shares_floors(&self) -> bool {
             true
         }
-        fn peers_floor(&self, _: usize) -> Option<Floor> {
-            Some(Floor::INFINITY)
+        fn peers_floor(&self, _: usize) -> Option<Bounds> {
+            Some(Bounds {
+                any: Floor::INFINITY,
+                messages: Floor::INFINITY,
+            })
         }
     }
 
@@ -923,5 +945,96 @@ mod tests {
         assert_eq!(json(seq.states()), json(tw.states()));
         let handled: Vec<u64> = tw.states().iter().map(|s| s.handled).collect();
         assert_ne!(halfway, handled, "the second leg ran");
+    }
+
+    /// Objects on alternating workers that pass tokens on with zero delay through the
+    /// generations of instant 0. In the first generation each also leaves a message that can be
+    /// cancelled for an object of the other worker, two generations later, and wakes itself for
+    /// that generation, where a third of them cancel theirs: cancellations of messages of the
+    /// cancelling batch's own virtual time, beside batches of messages no one can cancel, which
+    /// run as final against the other workers' next generation.
+    struct Relay;
+
+    const RELAYS: u32 = 48;
+
+    impl Model for Relay {
+        type Msg = u64;
+        type State = (u64, Option<crate::kernel::Handle>);
+        type Output = ();
+
+        fn kind_names(&self) -> &'static [&'static str] {
+            &["Pass"]
+        }
+        fn kind(&self, _: &u64) -> usize {
+            0
+        }
+        fn priority(&self, _: &u64) -> u8 {
+            0
+        }
+        fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, _: &mut Self::State) {
+            ctx.send_now((me + 1) % RELAYS, u64::from(me));
+        }
+        fn handle(
+            &self,
+            ctx: &mut Ctx<'_, Self>,
+            me: u32,
+            state: &mut Self::State,
+            batch: &[Envelope<u64>],
+        ) {
+            for e in batch {
+                state.0 = state
+                    .0
+                    .wrapping_mul(31)
+                    .wrapping_add(e.msg ^ u64::from(e.from));
+            }
+            let now = ctx.now().clone();
+            if now.gen == 1 {
+                let later = VTime {
+                    key: now.key.clone(),
+                    gen: 3,
+                };
+                // to a higher-numbered object of the other worker, so that its batch of
+                // generation 3 comes after this object's
+                let to = (me + 3).min(RELAYS - 1 - me % 2);
+                state.1 = Some(ctx.send_at(to, later, 1000 + u64::from(me)));
+            }
+            if now.gen == 2 {
+                ctx.send_now(me, 0);
+            }
+            if now.gen == 3 && me.is_multiple_of(3) {
+                if let Some(h) = state.1.take() {
+                    ctx.cancel(h);
+                }
+            }
+            if now.gen < 6 {
+                ctx.send_now((me * 5 + 1) % RELAYS, state.0 & 0xffff);
+            }
+        }
+    }
+
+    #[test]
+    fn cancellations_within_an_instant_beside_batches_run_as_final_by_generation() {
+        use crate::kernel::sequential::Sequential;
+        let states = vec![(0, None); RELAYS as usize];
+        let mut seq = Sequential::new(Relay, states.clone(), at(0.0));
+        seq.run::<()>(1.0, &mut |_, _, _| Ok(())).unwrap();
+        let want: Vec<u64> = seq.states().iter().map(|s| s.0).collect();
+        for workers in [2, 3] {
+            for chaos in [None, Some(7), Some(8)] {
+                let worker_of: Vec<u32> = (0..RELAYS).map(|o| o % workers).collect();
+                let cfg = TwConfig {
+                    workers: workers as usize,
+                    chaos,
+                    ..TwConfig::default()
+                };
+                let mut tw = TimeWarp::new(Relay, states.clone(), at(0.0), &worker_of, cfg);
+                tw.run::<()>(1.0, &mut |_, _, _| Ok(())).unwrap();
+                let got: Vec<u64> = tw.states().iter().map(|s| s.0).collect();
+                let what = format!("{workers} workers, chaos {chaos:?}");
+                assert_eq!(got, want, "{what}");
+                assert_eq!(tw.stats(), seq.stats(), "{what}");
+                assert_eq!(tw.tw_stats().committed, seq.stats().batches, "{what}");
+            }
+        }
     }
 }
