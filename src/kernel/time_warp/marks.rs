@@ -169,6 +169,29 @@ impl<Msg> Marks<Msg> {
         (false, None)
     }
 
+    /// Makes the cancellation of message `uid` by a batch at simulation time `at` final, as that
+    /// batch commits: it can no longer be undone, so the message is gone for good. Its count
+    /// leaves the cancellations (whose table stays as small as the uncommitted batches' share)
+    /// for a retraction, or the message is dropped at once if it was set aside. Nothing is left
+    /// to do if the cancellation's entry has gone: its message is already dropped.
+    pub fn promote(&mut self, uid: u64, at: f64) {
+        let Some(c) = self.cancels.get_mut(&uid) else {
+            return;
+        };
+        if let Some(k) = c.by.iter().position(|b| b.0.to_bits() == at.to_bits()) {
+            c.by[k].1 -= 1;
+            if c.by[k].1 == 0 {
+                c.by.swap_remove(k);
+            }
+        }
+        if c.by.is_empty() {
+            self.cancels.remove(&uid);
+        }
+        if self.dead.remove(&uid).is_none() {
+            self.retracted.insert(uid);
+        }
+    }
+
     /// Cancelled messages set aside.
     pub fn set_aside_len(&self) -> usize {
         self.dead.len()
@@ -297,6 +320,29 @@ mod tests {
         assert!(matches!(m.cancel(4, 2.0, 1.5, -1), (false, None)));
         assert!(matches!(m.cancel(4, 2.0, 1.0, 1), (true, None)));
         assert_eq!(m.of(4, true), Mark::Live);
+    }
+
+    #[test]
+    fn a_committed_cancellation_is_a_retraction() {
+        let mut m: Marks<u8> = Marks::default();
+        // in the heap: the cancellation's entry goes, and the message is dropped at the top
+        m.cancel(3, 2.0, 1.0, 1);
+        m.promote(3, 1.0);
+        assert_eq!(m.of(3, true), Mark::Annulled);
+        assert_eq!(m.pending_marks(), 1);
+        assert!(!m.keeps(3, true, 0.0));
+        assert_eq!(m.pending_marks(), 0);
+        // set aside: dropped at once, and the other cancellation's undoing brings nothing back
+        m.cancel(4, 2.0, 1.0, 1);
+        m.cancel(4, 2.0, 1.5, 1);
+        m.set_aside(4, msg(2.0), Mark::Cancelled, 0.0);
+        m.promote(4, 1.0);
+        assert_eq!(m.set_aside_len(), 0);
+        assert!(matches!(m.cancel(4, 2.0, 1.5, -1), (true, None)));
+        assert_eq!(m.pending_marks(), 0);
+        // a message already dropped leaves no mark behind
+        m.promote(5, 1.0);
+        assert_eq!(m.pending_marks(), 0);
     }
 
     #[test]

@@ -1389,6 +1389,12 @@ impl<M: Model> Worker<M> {
     /// after it, when observed).
     fn commit(&mut self, li: usize, mut d: Done<M>, state: Option<M::State>) {
         self.count_committed(d.into_past.take(), d.batch.len(), d.cancel_calls as usize);
+        // its cancellations are final now: those of messages here become retractions
+        for h in &d.cancels {
+            if self.placement.worker(h.to) == self.index {
+                self.marks.promote(h.uid, d.time.t());
+            }
+        }
         for (_, kind) in d.sent.drain(..) {
             self.committed_stats.count(usize::from(kind));
         }
