@@ -36,7 +36,7 @@ use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::Trajectory;
 use crate::kernel::{Ctx, Envelope, Model, SentPair, VTime};
 use crate::physics::{self, Contact};
-use crate::scenario::Scenario;
+use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, DISPLAY, REVERSAL};
 use std::sync::Arc;
 
@@ -59,6 +59,22 @@ pub struct BallInfo {
 }
 
 impl BallInfo {
+    /// A ball of the scenario as it starts at `t0`, shared with the messages that will carry it.
+    pub fn starting(b: &BallSpec, t0: f64) -> Arc<BallInfo> {
+        Arc::new(BallInfo {
+            traj: Trajectory {
+                position: b.position,
+                velocity: b.velocity,
+                t0,
+            },
+            radius: b.radius,
+            mass: b.mass,
+            fixed: Key::start(t0),
+            version: 0,
+            pocket: None,
+        })
+    }
+
     /// The trajectory is fixed at `key` now (a new version, unless it was fixed there already).
     pub fn fix(&mut self, key: &Key) {
         if self.fixed != *key {
@@ -260,18 +276,7 @@ impl Pool {
             .balls
             .iter()
             .map(|b| PoolState::Ball {
-                info: Arc::new(BallInfo {
-                    traj: Trajectory {
-                        position: b.position,
-                        velocity: b.velocity,
-                        t0: span.start,
-                    },
-                    radius: b.radius,
-                    mass: b.mass,
-                    fixed: Key::start(span.start),
-                    version: 0,
-                    pocket: None,
-                }),
+                info: BallInfo::starting(b, span.start),
                 planned: Vec::new(),
             })
             .collect();

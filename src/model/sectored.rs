@@ -395,18 +395,7 @@ impl Sectored {
             specs
                 .iter()
                 .map(|b| SecState::Ball {
-                    info: Arc::new(BallInfo {
-                        traj: Trajectory {
-                            position: b.position,
-                            velocity: b.velocity,
-                            t0: span.start,
-                        },
-                        radius: b.radius,
-                        mass: b.mass,
-                        fixed: Key::start(span.start),
-                        version: 0,
-                        pocket: None,
-                    }),
+                    info: BallInfo::starting(b, span.start),
                     planned: Vec::new(),
                     sectors: layout
                         .touching(b.position, b.radius)
