@@ -947,8 +947,9 @@ fn print_summary(summary: &serde_json::Value, json: bool) {
         s["final_state_digest"].as_str().unwrap_or("")
     );
     println!(
-        "wall          {:.3} s, {:.0} events/s{}",
+        "wall          {:.3} s ({:.3} s set-up), {:.0} events/s{}",
         s["wall_seconds"].as_f64().unwrap_or(0.0),
+        s["setup_seconds"].as_f64().unwrap_or(0.0),
         s["events_per_second"].as_f64().unwrap_or(0.0),
         if s["checked"] == true {
             ", invariants checked at every event"
@@ -956,6 +957,26 @@ fn print_summary(summary: &serde_json::Value, json: bool) {
             ""
         }
     );
+    let tw = &s["time_warp"];
+    if tw.is_object() {
+        let n = |k: &str| tw[k].as_u64().unwrap_or(0);
+        let share = |k: &str| 100.0 * n(k) as f64 / n("committed").max(1) as f64;
+        let count = |k: &str, one: &str| match n(k) {
+            1 => format!("1 {one}"),
+            m => format!("{m} {one}s"),
+        };
+        println!(
+            "time warp     {} on {}: efficiency {:.3}, {:.0} % of batches final, {} rollbacks, \
+             {:.2} % of messages remote, {} GVT rounds",
+            count("workers", "worker"),
+            count("ranks", "rank"),
+            tw["efficiency"].as_f64().unwrap_or(0.0),
+            share("final_batches"),
+            n("rollbacks"),
+            100.0 * tw["remote_fraction"].as_f64().unwrap_or(0.0),
+            n("gvt_rounds")
+        );
+    }
 }
 
 /// Arguments of `poolsim render`.

@@ -176,6 +176,14 @@ fn plain_run_prints_a_readable_summary() {
         .any(|l| l.starts_with("scenario") && l.ends_with("plate1")));
     assert!(out.contains("ball-ball 1"), "{out}");
     assert!(out.contains("ball-pocket 1"), "{out}");
+    assert!(!out.contains("time warp"), "{out}");
+    // under Time Warp, a line of its own statistics
+    let out = success(&["run", "plate1", "--engine", "time-warp", "--workers", "2"]);
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("time warp"))
+        .unwrap_or_else(|| panic!("no time warp line: {out}"));
+    assert!(line.contains("2 workers on 1 rank: efficiency"), "{line}");
 }
 
 #[test]
