@@ -113,7 +113,8 @@ struct RunArgs {
     /// Time Warp's memory budget: uncommitted batches per worker.
     #[arg(long = "tw-memory")]
     tw_memory: Option<usize>,
-    /// Batches a Time Warp worker runs between GVT rounds.
+    /// Batches a Time Warp worker runs between GVT rounds (default 2048 on threads, 256
+    /// across MPI ranks).
     #[arg(long = "gvt-interval")]
     gvt_interval: Option<u32>,
     /// Pure Time Warp: every batch runs optimistically, with its state saved, even one that
@@ -374,6 +375,10 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
     }
     #[cfg(feature = "mpi")]
     let _mpi = if tw.is_some() { start_mpi()? } else { None };
+    let mut tw = tw;
+    if let Some(c) = tw.as_mut() {
+        across_ranks(c, false);
+    }
     let partitions = a.partitions.unwrap_or_else(|| match &tw {
         Some(c) => poolsim::kernel::time_warp::threads::total_workers(c) as u32,
         None => 2,
@@ -709,6 +714,14 @@ fn tw_workers(workers: Option<usize>) -> Result<TwConfig, Failure> {
     Ok(tw)
 }
 
+/// Across MPI ranks (known once MPI has started) the GVT interval is
+/// [`time_warp::ACROSS_RANKS_GVT_INTERVAL`] unless `--gvt-interval` set it.
+fn across_ranks(tw: &mut TwConfig, set: bool) {
+    if !set && time_warp::threads::place().1 > 1 {
+        tw.gvt_interval = time_warp::ACROSS_RANKS_GVT_INTERVAL;
+    }
+}
+
 /// Time Warp's settings from the flags and `POOLSIM_CHAOS`.
 fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
     let mut tw = tw_workers(a.workers)?;
@@ -832,7 +845,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
             "--until: must be a finite number not below 0, got {until}"
         )));
     }
-    let cfg = RunConfig {
+    let mut cfg = RunConfig {
         engine,
         until,
         check: a.check,
@@ -840,6 +853,9 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
     };
     #[cfg(feature = "mpi")]
     let _mpi = if time_warp { start_mpi()? } else { None };
+    if let EngineKind::TimeWarp { tw, .. } = &mut cfg.engine {
+        across_ranks(tw, a.gvt_interval.is_some());
+    }
     // under MPI only rank 0 writes anything
     let root = poolsim::kernel::time_warp::threads::collects_results();
     let mut trace = match a.trace.as_ref().filter(|_| root) {
