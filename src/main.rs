@@ -375,10 +375,6 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
     }
     #[cfg(feature = "mpi")]
     let _mpi = if tw.is_some() { start_mpi()? } else { None };
-    let mut tw = tw;
-    if let Some(c) = tw.as_mut() {
-        across_ranks(c, false);
-    }
     let partitions = a.partitions.unwrap_or_else(|| match &tw {
         Some(c) => poolsim::kernel::time_warp::threads::total_workers(c) as u32,
         None => 2,
@@ -714,14 +710,6 @@ fn tw_workers(workers: Option<usize>) -> Result<TwConfig, Failure> {
     Ok(tw)
 }
 
-/// Across MPI ranks (known once MPI has started) the GVT interval is
-/// [`time_warp::ACROSS_RANKS_GVT_INTERVAL`] unless `--gvt-interval` set it.
-fn across_ranks(tw: &mut TwConfig, set: bool) {
-    if !set && time_warp::threads::place().1 > 1 {
-        tw.gvt_interval = time_warp::ACROSS_RANKS_GVT_INTERVAL;
-    }
-}
-
 /// Time Warp's settings from the flags and `POOLSIM_CHAOS`.
 fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
     let mut tw = tw_workers(a.workers)?;
@@ -745,7 +733,7 @@ fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
         if g == 0 {
             return Err(usage("--gvt-interval: must be at least 1"));
         }
-        tw.gvt_interval = g;
+        tw.gvt_interval = Some(g);
     }
     tw.final_batches = !a.tw_pure;
     Ok(tw)
@@ -845,7 +833,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
             "--until: must be a finite number not below 0, got {until}"
         )));
     }
-    let mut cfg = RunConfig {
+    let cfg = RunConfig {
         engine,
         until,
         check: a.check,
@@ -853,9 +841,6 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
     };
     #[cfg(feature = "mpi")]
     let _mpi = if time_warp { start_mpi()? } else { None };
-    if let EngineKind::TimeWarp { tw, .. } = &mut cfg.engine {
-        across_ranks(tw, a.gvt_interval.is_some());
-    }
     // under MPI only rank 0 writes anything
     let root = poolsim::kernel::time_warp::threads::collects_results();
     let mut trace = match a.trace.as_ref().filter(|_| root) {

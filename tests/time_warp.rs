@@ -55,7 +55,7 @@ fn pure_or_not(
         tw: TwConfig {
             workers,
             chaos,
-            gvt_interval: 256,
+            gvt_interval: Some(256),
             final_batches: !pure,
             ..TwConfig::default()
         },
@@ -194,7 +194,7 @@ fn a_tight_memory_budget_rolls_back_and_stays_exact() {
         tw: TwConfig {
             workers: 2,
             chaos: Some(3),
-            gvt_interval: 4096,
+            gvt_interval: Some(4096),
             max_uncommitted: 64,
             // every batch saved, so that the budget binds
             final_batches: false,
@@ -222,7 +222,7 @@ fn an_instant_commits_as_it_goes() {
     let engine = EngineKind::TimeWarp {
         tw: TwConfig {
             workers: 2,
-            gvt_interval: INTERVAL,
+            gvt_interval: Some(INTERVAL),
             ..TwConfig::default()
         },
         delay: NvDelay::Exact,
@@ -267,7 +267,7 @@ fn memory_stays_flat_over_many_gvt_rounds() {
     let worker_of: Vec<u32> = (0..512).map(|o| o / 256).collect();
     let tw = TwConfig {
         workers: 2,
-        gvt_interval: 512,
+        gvt_interval: Some(512),
         ..TwConfig::default()
     };
     let mut ex = TimeWarp::new(model, states, VTime::at(Key::start(0.0)), &worker_of, tw);

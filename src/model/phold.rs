@@ -327,7 +327,7 @@ mod time_warp_tests {
                 let tw_cfg = TwConfig {
                     workers,
                     chaos,
-                    gvt_interval: 64,
+                    gvt_interval: Some(64),
                     ..Default::default()
                 };
                 let mut tw = TimeWarp::new(

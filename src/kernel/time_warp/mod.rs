@@ -79,6 +79,9 @@ use std::cmp::Ordering;
 /// engines stop a ball's instant at 1,000 events too.
 pub const MAX_CASCADE_DEPTH: usize = 1_000;
 
+/// Batches between GVT rounds in one process, unless set.
+pub const THREADS_GVT_INTERVAL: u32 = 2048;
+
 /// Batches between GVT rounds across MPI ranks, unless set: ops for another rank travel only
 /// at rounds, so the interval is also their delay, and a long one makes stragglers. On 2 ranks
 /// on loopback (gas, 1 worker each), 2,048 against 256: 400 balls, efficiency 0.37 against
@@ -93,8 +96,9 @@ pub struct TwConfig {
     pub workers: usize,
     /// Seed of chaos mode: deliveries delayed and reordered at random to force rollbacks.
     pub chaos: Option<u64>,
-    /// Batches a worker runs between GVT rounds.
-    pub gvt_interval: u32,
+    /// Batches a worker runs between GVT rounds; `None` for the default of where it runs
+    /// ([`TwConfig::interval`]).
+    pub gvt_interval: Option<u32>,
     /// Optimism window: no batch later than GVT plus this (simulation time); `None` adapts it
     /// to four times the GVT advance of the last round.
     pub window: Option<f64>,
@@ -106,12 +110,24 @@ pub struct TwConfig {
     pub final_batches: bool,
 }
 
+impl TwConfig {
+    /// Batches between GVT rounds on `ranks` MPI ranks: as set, else
+    /// [`THREADS_GVT_INTERVAL`] in one process and [`ACROSS_RANKS_GVT_INTERVAL`] across ranks.
+    pub fn interval(&self, ranks: usize) -> u32 {
+        self.gvt_interval.unwrap_or(if ranks > 1 {
+            ACROSS_RANKS_GVT_INTERVAL
+        } else {
+            THREADS_GVT_INTERVAL
+        })
+    }
+}
+
 impl Default for TwConfig {
     fn default() -> TwConfig {
         TwConfig {
             workers: 1,
             chaos: None,
-            gvt_interval: 2048,
+            gvt_interval: None,
             window: None,
             max_uncommitted: 1 << 21,
             final_batches: true,
@@ -1554,8 +1570,9 @@ impl<M: Model> Worker<M> {
     ) -> Result<(), Stop> {
         let mut buf = Vec::new();
         let mut since = 0u32;
+        let interval = cfg.interval(threads::place().1);
         // uncommitted batches past which a worker runs only final ones
-        let ahead = 2 * cfg.gvt_interval as usize;
+        let ahead = 2 * interval as usize;
         self.ship = ship;
         self.final_ok = cfg.final_batches && fabric.shares_floors();
         self.flush(fabric);
@@ -1592,18 +1609,18 @@ impl<M: Model> Worker<M> {
             self.commit_early(model);
             since += ran.max(1);
             if ran == 0 && !held_back {
-                since = cfg.gvt_interval;
+                since = interval;
             }
             if ran == 0 && self.chaos.is_none() {
                 std::thread::yield_now();
             }
             let over = self.held() > cfg.max_uncommitted.saturating_mul(4);
             if over || self.fault.is_some() {
-                since = cfg.gvt_interval;
+                since = interval;
             }
             // chaos keeps each worker to its own count: the lockstep of the old rounds damps the
             // rollback echoes that its delays provoke, which otherwise may run for seconds
-            let due = since >= cfg.gvt_interval;
+            let due = since >= interval;
             let go = match self.chaos {
                 Some(_) => due,
                 None => fabric.round_due(self.index, self.round, due),
@@ -1706,6 +1723,20 @@ mod tests {
             uid: uid(5, 1),
             t,
         }
+    }
+
+    #[test]
+    fn the_gvt_interval_defaults_by_where_it_runs() {
+        let c = TwConfig::default();
+        assert_eq!(
+            (c.interval(1), c.interval(2)),
+            (THREADS_GVT_INTERVAL, ACROSS_RANKS_GVT_INTERVAL)
+        );
+        let set = TwConfig {
+            gvt_interval: Some(7),
+            ..c
+        };
+        assert_eq!((set.interval(1), set.interval(3)), (7, 7));
     }
 
     #[test]
