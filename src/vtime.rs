@@ -47,12 +47,31 @@ pub fn unpair(p: Pair) -> (u32, u32) {
 }
 
 /// A point of virtual time: a time and the path of pairs that orders events within an instant.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct Key {
     /// Simulation time.
     pub t: f64,
     /// The pair of the event, preceded by the pairs of the cascade that led to it.
     pub path: SmallVec<[Pair; 2]>,
+}
+
+/// Copies the path as one block: `SmallVec`'s own `clone` collects it item by item, and the
+/// executors copy a key for nearly every message.
+impl Clone for Key {
+    #[inline]
+    fn clone(&self) -> Self {
+        Key {
+            t: self.t,
+            path: SmallVec::from_slice(&self.path),
+        }
+    }
+
+    #[inline]
+    fn clone_from(&mut self, source: &Self) {
+        self.t = source.t;
+        self.path.clear();
+        self.path.extend_from_slice(&source.path);
+    }
 }
 
 impl Key {
@@ -127,6 +146,19 @@ impl Ord for Key {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_key_cloned_into_another_equals_its_source() {
+        let short = Key::at(1.5, pair(1, 2));
+        let long = short.child(pair(2, 3)).child(pair(3, 4)).child(pair(4, 5));
+        for (from, into) in [(&short, &long), (&long, &short), (&long, &long)] {
+            let mut copy = into.clone();
+            copy.clone_from(from);
+            assert_eq!(copy, *from);
+            assert_eq!(copy.path.as_slice(), from.path.as_slice());
+            assert_eq!(from.clone(), *from);
+        }
+    }
 
     #[test]
     fn pairs_are_canonical() {

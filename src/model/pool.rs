@@ -168,7 +168,7 @@ pub const RETURN_TO_TABLE: usize = 3;
 pub const DISPLAY_YOURSELF: usize = 4;
 
 /// One collision an object scheduled: the partner and the two Collision messages.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Planned {
     /// The other object of the collision (the one that is not the scheduler).
     pub partner: u32,

@@ -476,7 +476,10 @@ struct Input {
 
 /// Vectors of finished batches, kept for the next ones: a worker runs millions of batches, and
 /// each would otherwise allocate and free the same few small vectors.
-struct Spare<Msg> {
+struct Spare<Msg, State> {
+    /// Saved states freed by commits and rollbacks: a batch's state is saved into one of them
+    /// with `clone_from`, which reuses the buffers a model's state holds instead of allocating.
+    states: Vec<State>,
     inputs: Vec<Vec<Input>>,
     batches: Vec<Vec<Envelope<Msg>>>,
     sent: Vec<Vec<(Sent, u16)>>,
@@ -491,9 +494,10 @@ struct Spare<Msg> {
 /// Vectors of each kind kept at most.
 const SPARE: usize = 64;
 
-impl<Msg> Default for Spare<Msg> {
+impl<Msg, State> Default for Spare<Msg, State> {
     fn default() -> Self {
         Spare {
+            states: Vec::new(),
             inputs: Vec::new(),
             batches: Vec::new(),
             sent: Vec::new(),
@@ -644,7 +648,7 @@ pub struct Worker<M: Model> {
     /// Ops for this worker's objects.
     local_ops: Vec<Op<M::Msg>>,
     /// Vectors for the next batches.
-    spare: Spare<M::Msg>,
+    spare: Spare<M::Msg, M::State>,
     outbox: Vec<Vec<Op<M::Msg>>>,
     /// Chaos mode: its random stream and the ops it holds back.
     chaos: Option<Chaos<M::Msg>>,
@@ -938,7 +942,7 @@ impl<M: Model> Worker<M> {
             let d = self.log.pop_last(&mut lp.history).expect("a batch to undo");
             self.uncommitted -= 1;
             self.stats.rolled_back += 1;
-            lp.state = d.pre_state;
+            let undone = std::mem::replace(&mut lp.state, d.pre_state);
             lp.seq = d.pre_seq;
             let to = lp.id;
             let (mut inputs, mut batch, mut sent) = (d.inputs, d.batch, d.sent);
@@ -967,6 +971,26 @@ impl<M: Model> Worker<M> {
                 self.route(op);
             }
             give(&mut self.spare.cancels, cancels);
+            self.give_state(undone);
+        }
+    }
+
+    /// A copy of local object `li`'s state, to restore if its next batch is rolled back.
+    fn save_state(&mut self, li: usize) -> M::State {
+        let state = &self.lps[li].state;
+        match self.spare.states.pop() {
+            Some(mut saved) => {
+                saved.clone_from(state);
+                saved
+            }
+            None => state.clone(),
+        }
+    }
+
+    /// Keeps a saved state no batch needs any more, for [`Worker::save_state`] to reuse.
+    fn give_state(&mut self, state: M::State) {
+        if self.spare.states.len() < SPARE {
+            self.spare.states.push(state);
         }
     }
 
@@ -1111,6 +1135,7 @@ impl<M: Model> Worker<M> {
         if let Some(next) = self.heap.peek() {
             prefetch_all(&self.lps[self.placement.local(next.p.to)]);
         }
+        let pre_state = (!run_final).then(|| self.save_state(li));
         let lp = &mut self.lps[li];
         // GVT cannot pass an instant this deep, so it would pile up batches until memory ran
         // out; a cascade run on a state still to be rolled back may be wrong, and is stopped by
@@ -1122,7 +1147,6 @@ impl<M: Model> Worker<M> {
                 time.t()
             ));
         }
-        let pre_state = (!run_final).then(|| lp.state.clone());
         let (pre_seq, first) = (lp.seq, lp.uids);
         let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq).named(&mut lp.uids);
         ctx.sent = std::mem::take(&mut self.spare.pending);
@@ -1425,6 +1449,7 @@ impl<M: Model> Worker<M> {
         give(&mut self.spare.inputs, d.inputs);
         give(&mut self.spare.batches, d.batch);
         give(&mut self.spare.cancels, d.cancels);
+        self.give_state(d.pre_state);
         self.keep_for_collector(d.time, self.lps[li].id, state, d.output);
     }
 
