@@ -159,6 +159,9 @@ pub struct Envelope<M> {
     pub msg: M,
 }
 
+/// The most kinds of state [`Model::state_class`] tells apart.
+pub const STATE_CLASSES: usize = 4;
+
 /// A simulation model for the kernel: message and state types and the objects' behaviour.
 pub trait Model {
     /// Message payloads (serializable, so that Time Warp can carry them between ranks).
@@ -179,6 +182,13 @@ pub trait Model {
     fn observed(&self, obj: u32) -> bool {
         let _ = obj;
         true
+    }
+    /// Which of [`STATE_CLASSES`] kinds of state object `obj` holds: Time Warp saves an object's
+    /// state into a freed saved state of its own kind, whose buffers then fit without
+    /// allocating (see [`Clone::clone_from`]).
+    fn state_class(&self, obj: u32) -> usize {
+        let _ = obj;
+        0
     }
     /// Sets object `me` up at the start time; it may send messages.
     fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, state: &mut Self::State);

@@ -1090,6 +1090,12 @@ impl Model for Sectored {
         obj < self.table.n_balls
     }
 
+    /// Balls, fixed objects and sectors.
+    fn state_class(&self, obj: u32) -> usize {
+        let t = &self.table;
+        usize::from(obj >= t.n_balls) + usize::from(obj >= t.n_balls + t.n_fixed())
+    }
+
     /// Thesis 5.4: each ball sends VelocityInitialization to its sectors, which tell only the
     /// balls after it; fixed objects hear from every ball directly.
     fn init(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, state: &mut SecState) {

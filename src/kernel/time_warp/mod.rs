@@ -66,7 +66,10 @@ use log::{Chain, Log};
 use marks::{Mark, Marks};
 
 use super::queue::{Queue, Ranked};
-use super::{uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
+use super::{
+    uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT,
+    STATE_CLASSES,
+};
 use crate::engine::prefetch::prefetch_all;
 use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
@@ -477,9 +480,10 @@ struct Input {
 /// Vectors of finished batches, kept for the next ones: a worker runs millions of batches, and
 /// each would otherwise allocate and free the same few small vectors.
 struct Spare<Msg, State> {
-    /// Saved states freed by commits and rollbacks: a batch's state is saved into one of them
-    /// with `clone_from`, which reuses the buffers a model's state holds instead of allocating.
-    states: Vec<State>,
+    /// Saved states freed by commits and rollbacks, by [`Model::state_class`]: a batch's state
+    /// is saved into one of its kind with `clone_from`, which reuses the buffers the state
+    /// holds instead of allocating.
+    states: [Vec<State>; STATE_CLASSES],
     inputs: Vec<Vec<Input>>,
     batches: Vec<Vec<Envelope<Msg>>>,
     sent: Vec<Vec<(Sent, u16)>>,
@@ -497,7 +501,7 @@ const SPARE: usize = 64;
 impl<Msg, State> Default for Spare<Msg, State> {
     fn default() -> Self {
         Spare {
-            states: Vec::new(),
+            states: Default::default(),
             inputs: Vec::new(),
             batches: Vec::new(),
             sent: Vec::new(),
@@ -553,6 +557,8 @@ struct Done<M: Model> {
     time: VTime,
     /// The object's state before it.
     pre_state: M::State,
+    /// Its kind ([`Model::state_class`]).
+    class: u8,
     pre_seq: u64,
     /// The messages it handled: their names, and the envelopes the model saw.
     inputs: Vec<Input>,
@@ -971,14 +977,14 @@ impl<M: Model> Worker<M> {
                 self.route(op);
             }
             give(&mut self.spare.cancels, cancels);
-            self.give_state(undone);
+            self.give_state(d.class, undone);
         }
     }
 
     /// A copy of local object `li`'s state, to restore if its next batch is rolled back.
-    fn save_state(&mut self, li: usize) -> M::State {
+    fn save_state(&mut self, class: usize, li: usize) -> M::State {
         let state = &self.lps[li].state;
-        match self.spare.states.pop() {
+        match self.spare.states[class].pop() {
             Some(mut saved) => {
                 saved.clone_from(state);
                 saved
@@ -988,9 +994,10 @@ impl<M: Model> Worker<M> {
     }
 
     /// Keeps a saved state no batch needs any more, for [`Worker::save_state`] to reuse.
-    fn give_state(&mut self, state: M::State) {
-        if self.spare.states.len() < SPARE {
-            self.spare.states.push(state);
+    fn give_state(&mut self, class: u8, state: M::State) {
+        let spare = &mut self.spare.states[usize::from(class)];
+        if spare.len() < SPARE {
+            spare.push(state);
         }
     }
 
@@ -1135,7 +1142,8 @@ impl<M: Model> Worker<M> {
         if let Some(next) = self.heap.peek() {
             prefetch_all(&self.lps[self.placement.local(next.p.to)]);
         }
-        let pre_state = (!run_final).then(|| self.save_state(li));
+        let class = model.state_class(to).min(STATE_CLASSES - 1);
+        let pre_state = (!run_final).then(|| self.save_state(class, li));
         let lp = &mut self.lps[li];
         // GVT cannot pass an instant this deep, so it would pile up batches until memory ran
         // out; a cascade run on a state still to be rolled back may be wrong, and is stopped by
@@ -1203,6 +1211,7 @@ impl<M: Model> Worker<M> {
             let done = Done {
                 time,
                 pre_state: pre_state.expect("saved: the batch is not final"),
+                class: class as u8,
                 pre_seq,
                 inputs,
                 batch,
@@ -1449,7 +1458,7 @@ impl<M: Model> Worker<M> {
         give(&mut self.spare.inputs, d.inputs);
         give(&mut self.spare.batches, d.batch);
         give(&mut self.spare.cancels, d.cancels);
-        self.give_state(d.pre_state);
+        self.give_state(d.class, d.pre_state);
         self.keep_for_collector(d.time, self.lps[li].id, state, d.output);
     }
 
