@@ -91,11 +91,18 @@ fn fastest<T>(
 /// Each executor's fastest row over runs of the same rows (one run: the sequential engine, then
 /// Time Warp on 1 and 2 workers, taken in turn), with its speed-up against the fastest
 /// sequential row: the VM's speed drifts within a run of rows too, so a whole run's rows are no
-/// fairer a comparison than each one's best.
+/// fairer a comparison than each one's best. Beside it, the median over the runs of the
+/// speed-up within each run, which shows how far the best one stands from the typical one.
 fn fastest_rows(runs: Vec<Vec<TwRow>>) -> Vec<TwRow> {
+    let mut within: Vec<Vec<f64>> = Vec::new();
     let mut best: Vec<TwRow> = Vec::new();
     for run in runs {
+        let seq = run.first().map_or(0.0, |r| r.seconds);
         for (k, r) in run.into_iter().enumerate() {
+            if within.len() <= k {
+                within.push(Vec::new());
+            }
+            within[k].push(seq / r.seconds);
             match best.get_mut(k) {
                 Some(b) if r.seconds < b.seconds => *b = r,
                 Some(_) => {}
@@ -104,8 +111,11 @@ fn fastest_rows(runs: Vec<Vec<TwRow>>) -> Vec<TwRow> {
         }
     }
     let seq = best.first().map_or(0.0, |r| r.seconds);
-    for r in &mut best {
+    for (r, ratios) in best.iter_mut().zip(&mut within) {
         r.speedup = seq / r.seconds;
+        ratios.sort_by(f64::total_cmp);
+        let n = ratios.len();
+        r.median_speedup = 0.5 * (ratios[(n - 1) / 2] + ratios[n / 2]);
     }
     best
 }
@@ -383,12 +393,21 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         println!();
         println!(
             "Time Warp against the sequential objects engine: sectored gas (--sectors auto) \
-             until {}, whole runs, each engine's fastest of {} run in turn",
+             until {}, whole runs, each engine's fastest of {} run in turn (median: of the \
+             speed-ups within each turn)",
             a.tw_until, a.repeat
         );
         println!(
-            "{:>9} {:>8} {:>9} {:>9} {:>9} {:>11} {:>8} {:>6}  digest",
-            "balls", "workers", "wall s", "set-up s", "speed-up", "efficiency", "remote", "final"
+            "{:>9} {:>8} {:>9} {:>9} {:>9} {:>7} {:>11} {:>8} {:>6}  digest",
+            "balls",
+            "workers",
+            "wall s",
+            "set-up s",
+            "speed-up",
+            "median",
+            "efficiency",
+            "remote",
+            "final"
         );
     }
     let mut time_warp = Vec::new();
@@ -400,7 +419,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         for r in fastest_rows(runs) {
             if !a.json {
                 println!(
-                    "{:>9} {:>8} {:>9.3} {:>9.3} {:>9.2} {:>11.3} {:>8.3} {:>6.3}  {}",
+                    "{:>9} {:>8} {:>9.3} {:>9.3} {:>9.2} {:>7.2} {:>11.3} {:>8.3} {:>6.3}  {}",
                     r.balls,
                     if r.workers == 0 {
                         "seq".to_string()
@@ -410,6 +429,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                     r.seconds,
                     r.setup_seconds,
                     r.speedup,
+                    r.median_speedup,
                     r.efficiency,
                     r.remote_fraction,
                     r.final_fraction,
@@ -570,6 +590,9 @@ pub struct TwRow {
     pub setup_seconds: f64,
     /// The sequential run's seconds over this run's.
     pub speedup: f64,
+    /// Over repeated runs, the median of the speed-up within each run (the sequential engine
+    /// and Time Warp taken in turn); `speedup` is then the fastest over the fastest.
+    pub median_speedup: f64,
     /// Physical events.
     pub events: u64,
     /// Committed over processed batches (1 for the sequential engine).
@@ -645,6 +668,7 @@ fn time_warp_rows(balls: usize, until: f64, pure: bool) -> Result<Vec<TwRow>, St
             seconds,
             setup_seconds: report.setup_seconds,
             speedup: rows.first().map_or(1.0, |r| r.seconds / seconds),
+            median_speedup: rows.first().map_or(1.0, |r| r.seconds / seconds),
             events: report.outcome.events.total(),
             efficiency: tw["efficiency"].as_f64().unwrap_or(1.0),
             remote_fraction: tw["remote_fraction"].as_f64().unwrap_or(0.0),
@@ -706,6 +730,7 @@ mod tests {
             seconds,
             setup_seconds: 0.0,
             speedup: 0.0,
+            median_speedup: 0.0,
             events: 1,
             efficiency: 1.0,
             remote_fraction: 0.0,
@@ -715,13 +740,17 @@ mod tests {
         let runs = vec![
             vec![row(0, 4.0), row(1, 5.0), row(2, 3.0)],
             vec![row(0, 3.0), row(1, 6.0), row(2, 2.5)],
+            vec![row(0, 4.0), row(1, 8.0), row(2, 2.0)],
         ];
         let best = fastest_rows(runs);
         let got: Vec<(usize, f64, f64)> = best
             .iter()
             .map(|r| (r.workers, r.seconds, r.speedup))
             .collect();
-        assert_eq!(got, [(0, 3.0, 1.0), (1, 5.0, 0.6), (2, 2.5, 1.2)]);
+        assert_eq!(got, [(0, 3.0, 1.0), (1, 5.0, 0.6), (2, 2.0, 1.5)]);
+        // within each run: 2 workers at 4/3, 1.2 and 2; 1 worker at 0.8, 0.5 and 0.5
+        let medians: Vec<f64> = best.iter().map(|r| r.median_speedup).collect();
+        assert_eq!(medians, [1.0, 0.5, 4.0 / 3.0]);
     }
 
     #[test]
