@@ -661,14 +661,16 @@ fn time_warp_rows(balls: usize, until: f64, pure: bool) -> Result<Vec<TwRow>, St
             }
         }
         let seconds = report.wall_seconds;
+        let speedup = rows.first().map_or(1.0, |r| r.seconds / seconds);
         rows.push(TwRow {
             balls: n_balls,
             until,
             workers,
             seconds,
             setup_seconds: report.setup_seconds,
-            speedup: rows.first().map_or(1.0, |r| r.seconds / seconds),
-            median_speedup: rows.first().map_or(1.0, |r| r.seconds / seconds),
+            speedup,
+            // one run: its own speed-up is the median
+            median_speedup: speedup,
             events: report.outcome.events.total(),
             efficiency: tw["efficiency"].as_f64().unwrap_or(1.0),
             remote_fraction: tw["remote_fraction"].as_f64().unwrap_or(0.0),

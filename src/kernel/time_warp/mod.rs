@@ -981,16 +981,19 @@ impl<M: Model> Worker<M> {
         }
     }
 
-    /// A copy of local object `li`'s state, to restore if its next batch is rolled back.
-    fn save_state(&mut self, class: usize, li: usize) -> M::State {
+    /// A copy of the state of object `id` (local `li`), to restore if its next batch is rolled
+    /// back, with its kind ([`Model::state_class`]), for [`Worker::give_state`].
+    fn save_state(&mut self, model: &M, id: u32, li: usize) -> (u8, M::State) {
+        let class = model.state_class(id).min(STATE_CLASSES - 1);
         let state = &self.lps[li].state;
-        match self.spare.states[class].pop() {
+        let copy = match self.spare.states[class].pop() {
             Some(mut saved) => {
                 saved.clone_from(state);
                 saved
             }
             None => state.clone(),
-        }
+        };
+        (class as u8, copy)
     }
 
     /// Keeps a saved state no batch needs any more, for [`Worker::save_state`] to reuse.
@@ -1142,8 +1145,8 @@ impl<M: Model> Worker<M> {
         if let Some(next) = self.heap.peek() {
             prefetch_all(&self.lps[self.placement.local(next.p.to)]);
         }
-        let class = model.state_class(to).min(STATE_CLASSES - 1);
-        let pre_state = (!run_final).then(|| self.save_state(class, li));
+        // a batch run as final saves nothing, and asks nothing of the model for it
+        let saved = (!run_final).then(|| self.save_state(model, to, li));
         let lp = &mut self.lps[li];
         // GVT cannot pass an instant this deep, so it would pile up batches until memory ran
         // out; a cascade run on a state still to be rolled back may be wrong, and is stopped by
@@ -1208,10 +1211,11 @@ impl<M: Model> Worker<M> {
             if self.high.as_ref().is_none_or(|h| *h < time) {
                 self.high = Some(time.clone());
             }
+            let (class, pre_state) = saved.expect("saved: the batch is not final");
             let done = Done {
                 time,
-                pre_state: pre_state.expect("saved: the batch is not final"),
-                class: class as u8,
+                pre_state,
+                class,
                 pre_seq,
                 inputs,
                 batch,
