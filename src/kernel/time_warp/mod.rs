@@ -497,6 +497,9 @@ struct Spare<Msg, State> {
 
 /// Vectors of each kind kept at most.
 const SPARE: usize = 64;
+/// Saved states of each kind kept at most: as many as the uncommitted batches of a worker that
+/// runs ahead (two GVT intervals on threads), so that a worker saves states without allocating.
+const SPARE_STATES: usize = 4096;
 
 impl<Msg, State> Default for Spare<Msg, State> {
     fn default() -> Self {
@@ -935,6 +938,7 @@ impl<M: Model> Worker<M> {
     }
 
     /// Puts a message in the heap, in the instant's tier if it is for the key being run.
+    #[inline(always)]
     fn push(&mut self, it: Item<M::Msg>) {
         let in_instant = it.p.time.key == self.current;
         self.heap.push(it, in_instant);
@@ -999,7 +1003,7 @@ impl<M: Model> Worker<M> {
     /// Keeps a saved state no batch needs any more, for [`Worker::save_state`] to reuse.
     fn give_state(&mut self, class: u8, state: M::State) {
         let spare = &mut self.spare.states[usize::from(class)];
-        if spare.len() < SPARE {
+        if spare.len() < SPARE_STATES {
             spare.push(state);
         }
     }
@@ -1272,6 +1276,7 @@ impl<M: Model> Worker<M> {
     /// Sends a message a batch (or `init`) of this worker has just made. On this worker it goes
     /// straight to the heap: no mark can name it yet, and its receiver needs rolling back only
     /// if it ran ahead of it, which [`Worker::ran_past`] tells at a glance for most messages.
+    #[inline(always)]
     fn send(&mut self, uid: u64, p: Pending<M::Msg>) {
         self.stats.messages += 1;
         let w = self.placement.worker(p.to);
