@@ -8,7 +8,7 @@ use super::{
 use crate::kernel::sequential::Sink;
 use crate::kernel::{MessageStats, Model, VTime};
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{mpsc, Arc, Barrier, Mutex};
 
 /// The identity of [`Reduction::combine`].
@@ -257,6 +257,23 @@ where
             any: others.min(mine),
             messages: others.next_generation().min(mine),
         })
+    }
+}
+
+/// How long the collector sleeps between looks at the chunks the workers sent.
+const COLLECTOR_NAP: std::time::Duration = std::time::Duration::from_millis(10);
+
+/// Counts a worker's thread as ended, and wakes the collector, when the thread ends (by a
+/// panic too).
+struct WorkerEnd<'a> {
+    count: &'a AtomicUsize,
+    collector: &'a std::thread::Thread,
+}
+
+impl Drop for WorkerEnd<'_> {
+    fn drop(&mut self) {
+        self.count.fetch_add(1, Ordering::Release);
+        self.collector.unpark();
     }
 }
 
@@ -614,6 +631,7 @@ where
         failed: &mut Option<TwError<E>>,
     ) {
         let total = self.workers.len() * self.ranks;
+        let workers_here = self.workers.len();
         let stop = AtomicBool::new(false);
         let TimeWarp {
             model,
@@ -623,27 +641,34 @@ where
             ..
         } = self;
         let model: &M = model;
+        // the collector wakes every few milliseconds, and when the last worker ends: woken by
+        // every chunk, it took a worker's core twice per GVT round on a machine with as many
+        // cores as workers (2 workers at 10^5 balls ran 5 % faster without)
+        let (finished, main) = (AtomicUsize::new(0), std::thread::current());
         std::thread::scope(|scope| {
-            let handles: Vec<_> = workers
-                .iter_mut()
-                .map(|w| {
-                    let (stop, cfg, ship) = (&stop, &*cfg, collector.shipped);
-                    scope.spawn(move || w.run(model, fabric, cfg, until, ship, stop))
-                })
-                .collect();
+            for w in workers.iter_mut() {
+                let (stop, cfg, ship) = (&stop, &*cfg, collector.shipped);
+                let (finished, main) = (&finished, &main);
+                scope.spawn(move || {
+                    let _end = WorkerEnd {
+                        count: finished,
+                        collector: main,
+                    };
+                    w.run(model, fabric, cfg, until, ship, stop)
+                });
+            }
             loop {
-                match rx.recv_timeout(std::time::Duration::from_millis(1)) {
-                    Ok(chunk) => collector.take(model, total, chunk, sink, failed),
-                    Err(mpsc::RecvTimeoutError::Timeout) => {
-                        if handles.iter().all(|h| h.is_finished()) {
-                            break;
-                        }
-                    }
-                    Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                let done = finished.load(Ordering::Acquire) == workers_here;
+                for chunk in rx.try_iter() {
+                    collector.take(model, total, chunk, sink, failed);
                 }
                 if failed.is_some() {
                     stop.store(true, Ordering::Relaxed);
                 }
+                if done {
+                    break;
+                }
+                std::thread::park_timeout(COLLECTOR_NAP);
             }
         });
         for chunk in rx.try_iter() {
