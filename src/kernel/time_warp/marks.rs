@@ -130,7 +130,7 @@ impl<Msg> Marks<Msg> {
 
     /// A retraction: as [`Marks::annul`], for a message its sender may cancel.
     pub fn retract(&mut self, uid: u64) -> bool {
-        if self.dead.remove(&uid).is_some() {
+        if !self.dead.is_empty() && self.dead.remove(&uid).is_some() {
             return true;
         }
         self.retracted.insert(uid);

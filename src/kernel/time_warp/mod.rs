@@ -908,14 +908,7 @@ impl<M: Model> Worker<M> {
                     self.undo_handling(li, &time);
                 }
             }
-            // the canceller itself never handled its message, which comes after the batch that
-            // cancels it
-            Op::Retract { h, at, by } => {
-                let unseen = self.marks.cancelled(h.uid);
-                if !self.marks.retract(h.uid) && !unseen && h.to != by {
-                    self.undo_handling(li, &not_before(&h, at, by));
-                }
-            }
+            Op::Retract { h, at, by } => self.retract(h, &at, by),
             Op::Cancel { h, at, by, sign } => {
                 let (changed, back) = self.marks.cancel(h.uid, h.t, at.t(), sign);
                 if changed && h.to != by {
@@ -927,6 +920,17 @@ impl<M: Model> Worker<M> {
             }
         }
         self.note_entries();
+    }
+
+    /// A retraction of a message of this worker by the batch of `by` at `at` (the canceller
+    /// itself never handled its message, which comes after the batch that cancels it).
+    fn retract(&mut self, h: Handle, at: &VTime, by: u32) {
+        let unseen = self.marks.cancelled(h.uid);
+        // with no batch uncommitted, no batch handled it
+        if !self.marks.retract(h.uid) && !unseen && h.to != by && self.high.is_some() {
+            let li = self.placement.local(h.to);
+            self.undo_handling(li, &not_before(&h, at.clone(), by));
+        }
     }
 
     /// Rolls local object `li` back if it may have handled a message at `time` that is gone:
@@ -1261,13 +1265,17 @@ impl<M: Model> Worker<M> {
             self.committed_stats.count(model.kind(&p.env.msg));
             self.send(uid(id, n), p);
         }
-        // a committed cancellation is final
+        // a committed cancellation is final: one of a message here is marked at once
         for h in did.cancelled.iter().filter(|h| still_to_come(h, &did.time)) {
-            ops.push(Op::Retract {
-                h: *h,
-                at: did.time.clone(),
-                by: id,
-            });
+            if self.placement.worker(h.to) == self.index {
+                self.retract(*h, &did.time, id);
+            } else {
+                ops.push(Op::Retract {
+                    h: *h,
+                    at: did.time.clone(),
+                    by: id,
+                });
+            }
         }
         let state = (self.ship && model.observed(id)).then(|| self.lps[li].state.clone());
         self.keep_for_collector(did.time, id, state, did.output);
