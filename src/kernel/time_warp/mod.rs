@@ -1343,11 +1343,18 @@ impl<M: Model> Worker<M> {
         if self.next_time().is_none_or(|t| t <= self.gvt.t) {
             return;
         }
-        let t = self.heap.peek().expect("a valid top").p.time.clone();
+        let top = self.heap.peek().expect("a valid top");
+        let (t, first) = (top.p.time.clone(), top.p.to);
+        // only batches after the next one in (time, object) order: the others' floor of this
+        // worker, published before, may be that next batch, and what is undone goes back below
+        // it (an object before the top's at its time already ran there, in order)
+        let after = t.next_gen();
         for li in 0..self.lps.len() {
-            if self.last_time(li).is_some_and(|x| *x >= t) {
+            let from = if self.lps[li].id < first { &after } else { &t };
+            if self.last_time(li).is_some_and(|x| x >= from) {
                 self.stats.artificial_rollbacks += 1;
-                self.rollback(li, &t);
+                let from = from.clone();
+                self.rollback(li, &from);
             }
         }
         self.drain_local();
