@@ -1640,9 +1640,11 @@ impl<M: Model> Worker<M> {
             let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window);
             let mut limit = until.min(window);
             // short bursts publish floors often, so that the others' batches can run as final
+            // (8 against 4: 2 workers at 10^5 balls to t = 0.5 ran 4-5 % faster in 13 of 18
+            // pairs, with 59 % of the batches final against 60 %)
             let burst = match &mut self.chaos {
                 Some(c) => c.rng.gen_range(1..64u32),
-                None if self.final_ok => 4,
+                None if self.final_ok => 8,
                 None => 64,
             };
             let mut ran = 0;
