@@ -1353,8 +1353,7 @@ impl<M: Model> Worker<M> {
             let from = if self.lps[li].id < first { &after } else { &t };
             if self.last_time(li).is_some_and(|x| x >= from) {
                 self.stats.artificial_rollbacks += 1;
-                let from = from.clone();
-                self.rollback(li, &from);
+                self.rollback(li, from);
             }
         }
         self.drain_local();

@@ -643,7 +643,8 @@ where
         let model: &M = model;
         // the collector wakes every few milliseconds, and when the last worker ends: woken by
         // every chunk, it took a worker's core twice per GVT round on a machine with as many
-        // cores as workers (2 workers at 10^5 balls ran 5 % faster without)
+        // cores as workers (2 workers at 10^5 balls to t = 0.5: median ratios 0.95-1.00 in
+        // three sets of 10 pairs)
         let (finished, main) = (AtomicUsize::new(0), std::thread::current());
         std::thread::scope(|scope| {
             for w in workers.iter_mut() {
