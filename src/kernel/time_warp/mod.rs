@@ -103,7 +103,8 @@ pub struct TwConfig {
     /// ([`TwConfig::interval`]).
     pub gvt_interval: Option<u32>,
     /// Optimism window: no batch later than GVT plus this (simulation time); `None` adapts it
-    /// to the GVT progress of 1,024 of a worker's batches at the last round's rate.
+    /// to the GVT progress of one batch per object of the worker (1,024 to 8,192 batches) at the
+    /// last round's rate.
     pub window: Option<f64>,
     /// Uncommitted batches a worker may hold before it rolls its furthest objects back and
     /// runs only batches at GVT; past four times this, the run stops with an error.
@@ -515,23 +516,28 @@ impl<Msg, State> Default for Spare<Msg, State> {
     }
 }
 
-/// Batches' worth of GVT progress the optimism window spans when none is set: four GVT
-/// intervals across MPI ranks, half of one on threads. Wider windows cost efficiency in small
-/// models: the 36-ball gas on 2 workers ran at an efficiency of about 0.11 with 8,192 batches'
-/// worth, and at medians of 0.22-0.29 over 10 runs with 1,024, as with the former window of
-/// four times the last round's advance.
-const WINDOW_BATCHES: f64 = 1024.0;
+/// Batches' worth of GVT progress the optimism window spans when none is set, for a worker
+/// with `objects` objects: one per object, at least 1,024 and at most 8,192.
+///
+/// Too narrow, and workers run out of work under the window and ask for rounds (on 16 cores,
+/// 10^5 balls on 16 workers: 1,100-1,300 rounds and 0.45-0.48 s at 1,024, 350-590 rounds and
+/// 0.37-0.44 s at 4,096 or 8,192); too wide, and a small model runs far ahead only to roll
+/// back (the 36-ball gas on 2 workers of this 2-core VM: median efficiency 0.25 at 1,024,
+/// 0.12-0.14 at 4,096-8,192).
+fn window_span(objects: usize) -> f64 {
+    (objects as f64).clamp(1024.0, 8192.0)
+}
 
 /// The optimism window when none is set, after a GVT round that moved GVT by `advance` while
-/// this worker ran `ran` batches: [`WINDOW_BATCHES`] batches' worth of progress at that rate,
-/// growing at most twofold a round.
+/// this worker ran `ran` batches: `span` batches' worth of progress at that rate, growing at
+/// most twofold a round.
 ///
 /// A rate per batch, not one round's advance: a worker out of work under the window asks for a
 /// round at once, so a window of 4x the last advance collapsed on 12-16 workers, rounds coming
 /// ever more often and each moving GVT ever less (on 16 cores, 14,000 rounds where 300-900
 /// did, and 2-4x the time).
-fn auto_window(old: f64, advance: f64, ran: u64) -> f64 {
-    (advance / ran.max(1) as f64 * WINDOW_BATCHES).min(2.0 * old)
+fn auto_window(old: f64, advance: f64, ran: u64, span: f64) -> f64 {
+    (advance / ran.max(1) as f64 * span).min(2.0 * old)
 }
 
 /// A spare vector, or a new one.
@@ -1731,6 +1737,7 @@ impl<M: Model> Worker<M> {
                             self.auto_window,
                             gvt.t - self.gvt.t,
                             self.stats.processed - processed_then,
+                            window_span(self.lps.len()),
                         );
                     }
                     processed_then = self.stats.processed;
@@ -1825,20 +1832,23 @@ mod tests {
     #[test]
     fn the_optimism_window_follows_the_rate_of_progress_not_the_rounds() {
         // one round after 1024 batches or 16 rounds after 64 each: the same window
-        let one = auto_window(f64::INFINITY, 0.016, 1024);
+        let one = auto_window(f64::INFINITY, 0.016, 1024, 1024.0);
         let mut w = one;
         for _ in 0..16 {
-            w = auto_window(w, 0.001, 64);
+            w = auto_window(w, 0.001, 64, 1024.0);
         }
         assert!(
             (one - 0.016).abs() < 1e-12 && (w - one).abs() < 1e-12,
             "{one} {w}"
         );
         // it narrows at once where progress slows, and widens at most twofold a round
-        assert!((auto_window(one, 0.0016, 1024) - 0.0016).abs() < 1e-12);
-        assert_eq!(auto_window(0.01, 1.0, 1024), 0.02);
+        assert!((auto_window(one, 0.0016, 1024, 1024.0) - 0.0016).abs() < 1e-12);
+        assert_eq!(auto_window(0.01, 1.0, 1024, 1024.0), 0.02);
         // a worker that ran nothing is counted as having run one batch
-        assert_eq!(auto_window(f64::INFINITY, 0.5, 0), 512.0);
+        assert_eq!(auto_window(f64::INFINITY, 0.5, 0, 1024.0), 512.0);
+        // the span: one batch per object, within bounds
+        let spans = [10, 5000, 100_000].map(window_span);
+        assert_eq!(spans, [1024.0, 5000.0, 8192.0]);
     }
 
     #[test]
