@@ -103,8 +103,8 @@ pub struct TwConfig {
     /// ([`TwConfig::interval`]).
     pub gvt_interval: Option<u32>,
     /// Optimism window: no batch later than GVT plus this (simulation time); `None` adapts it
-    /// to the GVT progress of one batch per object of the worker (1,024 to 8,192 batches) at the
-    /// last round's rate.
+    /// to the GVT progress of one batch per message waiting on the worker (1,024 to 8,192
+    /// batches) at the last round's rate.
     pub window: Option<f64>,
     /// Uncommitted batches a worker may hold before it rolls its furthest objects back and
     /// runs only batches at GVT; past four times this, the run stops with an error.
@@ -517,15 +517,15 @@ impl<Msg, State> Default for Spare<Msg, State> {
 }
 
 /// Batches' worth of GVT progress the optimism window spans when none is set, for a worker
-/// with `objects` objects: one per object, at least 1,024 and at most 8,192.
+/// with `pending` messages waiting: one per message, at least 1,024 and at most 8,192.
 ///
 /// Too narrow, and workers run out of work under the window and ask for rounds (on 16 cores,
-/// 10^5 balls on 16 workers: 1,100-1,300 rounds and 0.45-0.48 s at 1,024, 350-590 rounds and
-/// 0.37-0.44 s at 4,096 or 8,192); too wide, and a small model runs far ahead only to roll
-/// back (the 36-ball gas on 2 workers of this 2-core VM: median efficiency 0.25 at 1,024,
-/// 0.12-0.14 at 4,096-8,192).
-fn window_span(objects: usize) -> f64 {
-    (objects as f64).clamp(1024.0, 8192.0)
+/// on 16 workers: 10^5 balls took 1,100-1,400 rounds and 0.40-0.48 s at 1,024, 350-590 rounds
+/// and 0.37-0.44 s at 4,096 or 8,192; PHOLD with 16,384 objects 0.42-0.60 s at 1,024, 0.27-0.32
+/// s at 8,192); too wide, and a small model runs far ahead only to roll back (the 36-ball gas
+/// on 2 workers of this 2-core VM: median efficiency 0.25 at 1,024, 0.12-0.14 at 4,096-8,192).
+fn window_span(pending: usize) -> f64 {
+    (pending as f64).clamp(1024.0, 8192.0)
 }
 
 /// The optimism window when none is set, after a GVT round that moved GVT by `advance` while
@@ -1737,7 +1737,7 @@ impl<M: Model> Worker<M> {
                             self.auto_window,
                             gvt.t - self.gvt.t,
                             self.stats.processed - processed_then,
-                            window_span(self.lps.len()),
+                            window_span(self.heap.len()),
                         );
                     }
                     processed_then = self.stats.processed;
@@ -1846,7 +1846,7 @@ mod tests {
         assert_eq!(auto_window(0.01, 1.0, 1024, 1024.0), 0.02);
         // a worker that ran nothing is counted as having run one batch
         assert_eq!(auto_window(f64::INFINITY, 0.5, 0, 1024.0), 512.0);
-        // the span: one batch per object, within bounds
+        // the span: one batch per pending message, within bounds
         let spans = [10, 5000, 100_000].map(window_span);
         assert_eq!(spans, [1024.0, 5000.0, 8192.0]);
     }
