@@ -47,17 +47,23 @@ pub struct BenchArgs {
         default_value = "1024,4096"
     )]
     pub sectored_balls: Vec<usize>,
-    /// Ball counts for Time Warp on 1 and 2 workers against the sequential objects engine: whole
-    /// runs of the sectored gas (`--sectors auto`) until `--tw-until`, set-up included.
+    /// Ball counts for Time Warp (on each of `--tw-workers`) against the sequential objects
+    /// engine: whole runs of the sectored gas (`--sectors auto`) until `--tw-until`, set-up
+    /// included.
     #[arg(long = "tw-balls", value_delimiter = ',', default_value = "9801")]
     pub tw_balls: Vec<usize>,
+    /// Worker counts of the Time Warp and PHOLD rows.
+    #[arg(long = "tw-workers", value_delimiter = ',', default_value = "1,2")]
+    pub tw_workers: Vec<usize>,
     /// Simulated time of the Time Warp runs.
     #[arg(long = "tw-until", default_value_t = 1.0)]
     pub tw_until: f64,
     /// Pure Time Warp in the Time Warp and PHOLD runs: no batch runs as final.
     #[arg(long = "tw-pure")]
     pub tw_pure: bool,
-    /// PHOLD objects (16 messages each, remote 0.1, 2 partitions, lookahead 0.1).
+    /// PHOLD objects (16 messages each, remote 0.1, lookahead 0.1; as many partitions as the
+    /// most workers of `--tw-workers`, at least 2, in every row, so that every row runs one
+    /// model).
     #[arg(long = "phold-objects", default_value_t = 1024)]
     pub phold_objects: u32,
     /// Grid cell width in ball diameters.
@@ -89,7 +95,7 @@ fn fastest<T>(
 }
 
 /// Each executor's fastest row over runs of the same rows (one run: the sequential engine, then
-/// Time Warp on 1 and 2 workers, taken in turn), with its speed-up against the fastest
+/// Time Warp on each worker count, taken in turn), with its speed-up against the fastest
 /// sequential row: the VM's speed drifts within a run of rows too, so a whole run's rows are no
 /// fairer a comparison than each one's best. Beside it, the median over the runs of the
 /// speed-up within each run, which shows how far the best one stands from the typical one.
@@ -294,9 +300,14 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     if a.events == 0 {
         return Err("--events: must be at least 1".into());
     }
-    if a.phold_objects < 2 {
+    if a.tw_workers.is_empty() || a.tw_workers.contains(&0) {
+        return Err("--tw-workers: each worker count must be at least 1".into());
+    }
+    let partitions = a.tw_workers.iter().copied().max().unwrap_or(2).max(2);
+    if (a.phold_objects as usize) < partitions {
         return Err(format!(
-            "--phold-objects: PHOLD runs on two partitions, so it needs at least 2 objects, got {}",
+            "--phold-objects: PHOLD runs on {partitions} partitions here, so it needs at least \
+             {partitions} objects, got {}",
             a.phold_objects
         ));
     }
@@ -414,7 +425,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
     for &n in &a.tw_balls {
         let mut runs = Vec::new();
         for _ in 0..a.repeat.max(1) {
-            runs.push(measure_time_warp(n, a.tw_until, a.tw_pure)?);
+            runs.push(measure_time_warp(n, a.tw_until, a.tw_pure, &a.tw_workers)?);
         }
         for r in fastest_rows(runs) {
             if !a.json {
@@ -439,24 +450,37 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             time_warp.push(r);
         }
     }
-    // PHOLD: the sequential kernel, then Time Warp on 1 and 2 workers (2 partitions each)
+    // PHOLD: the sequential kernel, then Time Warp on each worker count, one model throughout
     let phold_cfg = crate::model::phold::PholdConfig {
         objects: a.phold_objects,
         events_per_object: 16,
         remote: 0.1,
-        partitions: 2,
+        partitions: partitions as u32,
         lookahead: 0.1,
         mean: 1.0,
         seed: 1,
     };
-    let mut phold = Vec::new();
-    for workers in [None, Some(1), Some(2)] {
+    let mut phold: Vec<crate::model::phold::PholdReport> = Vec::new();
+    for workers in std::iter::once(None).chain(a.tw_workers.iter().map(|&w| Some(w))) {
         let tw = workers.map(|w| crate::kernel::time_warp::TwConfig {
             workers: w,
             final_batches: !a.tw_pure,
             ..Default::default()
         });
-        phold.push(crate::model::phold::run(phold_cfg.clone(), 20.0, tw)?);
+        let p = crate::model::phold::run(phold_cfg.clone(), 20.0, tw)?;
+        if let Some(first) = phold
+            .first()
+            .filter(|f| f.final_state_digest != p.final_state_digest)
+        {
+            return Err(format!(
+                "bench: PHOLD under Time Warp on {} workers ended in state {}, on the sequential \
+                 kernel in {}",
+                workers.unwrap_or(0),
+                p.final_state_digest,
+                first.final_state_digest
+            ));
+        }
+        phold.push(p);
     }
     if a.json {
         println!(
@@ -470,9 +494,10 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         for p in &phold {
             let workers = p.time_warp.as_ref().map_or(0, |t| t.workers);
             println!(
-                "PHOLD {} objects x 16 events, remote 0.1, end 20, {} ({} workers): {} \
-                 committed, {:.0} events/s, efficiency {:.3}, digest {}",
+                "PHOLD {} objects x 16 events, remote 0.1, {} partitions, end 20, {} ({} \
+                 workers): {} committed, {:.0} events/s, efficiency {:.3}, digest {}",
                 p.objects,
+                p.partitions,
                 p.engine,
                 workers,
                 p.committed,
@@ -607,21 +632,31 @@ pub struct TwRow {
 }
 
 /// Runs the sectored gas (`--sectors auto`) of `balls` balls until `until` on the sequential
-/// objects engine and under Time Warp on 1 and 2 workers (`pure`: no batch run as final);
+/// objects engine and under Time Warp on each of `workers` (`pure`: no batch run as final);
 /// fails if any digest differs. All of them run without transparent huge pages, as
 /// `poolsim run` runs the objects engines ([`crate::memory`]).
-pub fn measure_time_warp(balls: usize, until: f64, pure: bool) -> Result<Vec<TwRow>, String> {
+pub fn measure_time_warp(
+    balls: usize,
+    until: f64,
+    pure: bool,
+    workers: &[usize],
+) -> Result<Vec<TwRow>, String> {
     crate::memory::transparent_huge_pages(false);
-    let rows = time_warp_rows(balls, until, pure);
+    let rows = time_warp_rows(balls, until, pure, workers);
     crate::memory::transparent_huge_pages(true);
     rows
 }
 
-fn time_warp_rows(balls: usize, until: f64, pure: bool) -> Result<Vec<TwRow>, String> {
+fn time_warp_rows(
+    balls: usize,
+    until: f64,
+    pure: bool,
+    workers: &[usize],
+) -> Result<Vec<TwRow>, String> {
     use crate::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
     let (n_balls, scenario) = thesis_gas(balls, None)?;
     let mut rows: Vec<TwRow> = Vec::new();
-    for workers in [0, 1, 2] {
+    for workers in std::iter::once(0).chain(workers.iter().copied()) {
         let engine = match workers {
             0 => EngineKind::Sectored {
                 sectors: SectorChoice::Auto,
@@ -703,10 +738,10 @@ mod tests {
 
     #[test]
     fn time_warp_rows_agree_with_the_sequential_run() {
-        let rows = measure_time_warp(100, 0.5, false).unwrap();
+        let rows = measure_time_warp(100, 0.5, false, &[1, 2, 3]).unwrap();
         assert_eq!(
             rows.iter().map(|r| r.workers).collect::<Vec<_>>(),
-            [0, 1, 2]
+            [0, 1, 2, 3]
         );
         assert!(rows
             .iter()
@@ -718,7 +753,7 @@ mod tests {
         assert_eq!(rows[1].efficiency, 1.0);
         // alone, a worker runs every batch as final; pure, none
         assert_eq!((rows[0].final_fraction, rows[1].final_fraction), (0.0, 1.0));
-        let pure = measure_time_warp(100, 0.5, true).unwrap();
+        let pure = measure_time_warp(100, 0.5, true, &[1, 2]).unwrap();
         assert!(pure.iter().all(|r| r.final_fraction == 0.0));
         assert!(pure.iter().all(|r| r.digest == rows[0].digest));
     }

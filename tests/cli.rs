@@ -810,6 +810,10 @@ fn usage_errors_say_what_is_wrong_on_one_line() {
         bad_usage(&["run", "gas", "--engine", "objects", "--sectors", "1000"]).contains("250000")
     );
     assert!(bad_usage(&["bench", "--phold-objects", "1"]).contains("--phold-objects"));
+    assert!(bad_usage(&["bench", "--tw-workers", "1,0"]).contains("--tw-workers"));
+    assert!(
+        bad_usage(&["bench", "--tw-workers", "8", "--phold-objects", "4"]).contains("8 partitions")
+    );
     assert!(bad_usage(&["phold", "--objects", "4294967295"]).contains("events in flight"));
     let line = bad_usage(&[
         "run",
