@@ -104,7 +104,7 @@ pub struct TwConfig {
     pub gvt_interval: Option<u32>,
     /// Optimism window: no batch later than GVT plus this (simulation time); `None` adapts it
     /// to the GVT progress of one batch per message waiting on the worker (1,024 to 8,192
-    /// batches) at the last round's rate.
+    /// batches) at the recent rate, narrowed while many batches roll back.
     pub window: Option<f64>,
     /// Uncommitted batches a worker may hold before it rolls its furthest objects back and
     /// runs only batches at GVT; past four times this, the run stops with an error.
@@ -523,21 +523,76 @@ impl<Msg, State> Default for Spare<Msg, State> {
 /// on 16 workers: 10^5 balls took 1,100-1,400 rounds and 0.40-0.48 s at 1,024, 350-590 rounds
 /// and 0.37-0.44 s at 4,096 or 8,192; PHOLD with 16,384 objects 0.42-0.60 s at 1,024, 0.27-0.32
 /// s at 8,192); too wide, and a small model runs far ahead only to roll back (the 36-ball gas
-/// on 2 workers of this 2-core VM: median efficiency 0.25 at 1,024, 0.12-0.14 at 4,096-8,192).
+/// on 2 workers of this 2-core VM, before the scale of [`AutoWindow`]: median efficiency 0.25
+/// at 1,024, 0.12-0.14 at 4,096-8,192).
 fn window_span(pending: usize) -> f64 {
     (pending as f64).clamp(1024.0, 8192.0)
 }
 
-/// The optimism window when none is set, after a GVT round that moved GVT by `advance` while
-/// this worker ran `ran` batches: `span` batches' worth of progress at that rate, growing at
-/// most twofold a round.
+/// The optimism window when none is set (no `--tw-window`), in simulation time: GVT's progress
+/// over [`window_span`] of this worker's batches, at the rate per batch seen since the window
+/// last changed, times a scale that rollbacks narrow.
 ///
 /// A rate per batch, not one round's advance: a worker out of work under the window asks for a
 /// round at once, so a window of 4x the last advance collapsed on 12-16 workers, rounds coming
 /// ever more often and each moving GVT ever less (on 16 cores, 14,000 rounds where 300-900
-/// did, and 2-4x the time).
-fn auto_window(old: f64, advance: f64, ran: u64, span: f64) -> f64 {
-    (advance / ran.max(1) as f64 * span).min(2.0 * old)
+/// did, and 2-4x the time). The scale halves when a quarter or more of the worker's batches since
+/// the last change were rolled back, down to 1/16, and doubles back to 1 when fewer were. With
+/// the scale and the samples, the 36-ball gas on 2 workers of this 2-core VM ran at median
+/// efficiencies of 0.42 (sectored) and 0.44 (not) over 10 runs, against 0.21 and 0.27 without;
+/// 9,801 balls on 8 and 16 workers sharing its 2 cores at 0.78 and 0.61-0.63, against 0.68
+/// and 0.34 (the window of 4x the advance: 0.90 and 0.83, in 1,400-3,000 rounds).
+struct AutoWindow {
+    /// The window; infinite until GVT first moves.
+    width: f64,
+    scale: f64,
+    /// The worker's processed and rolled-back batches when the window last changed, and GVT's
+    /// progress since.
+    processed: u64,
+    rolled_back: u64,
+    moved: f64,
+}
+
+impl AutoWindow {
+    /// The smallest scale.
+    const MIN_SCALE: f64 = 1.0 / 16.0;
+    /// The fewest batches the worker runs between two changes of the window: a worker that
+    /// ran only a few in a round (held off its core, say) would see a rate per batch far too
+    /// high.
+    const SAMPLE: u64 = 256;
+
+    fn new() -> Self {
+        AutoWindow {
+            width: f64::INFINITY,
+            scale: 1.0,
+            processed: 0,
+            rolled_back: 0,
+            moved: 0.0,
+        }
+    }
+
+    /// Adapts the window after a round that moved GVT by `advance` (zero if it did not, or
+    /// was not finite), with `pending` messages waiting on the worker and its counts in
+    /// `stats`, once the worker has run [`Self::SAMPLE`] batches since the last change; the
+    /// width grows at most twofold a change.
+    fn after_round(&mut self, advance: f64, pending: usize, stats: &TwStats) {
+        self.moved += advance;
+        let ran = stats.processed - self.processed;
+        if ran < Self::SAMPLE {
+            return;
+        }
+        let undone = stats.rolled_back - self.rolled_back;
+        self.scale = if 4 * undone >= ran {
+            (self.scale / 2.0).max(Self::MIN_SCALE)
+        } else {
+            (self.scale * 2.0).min(1.0)
+        };
+        if self.moved > 0.0 {
+            let span = window_span(pending) * self.scale;
+            self.width = (self.moved / ran as f64 * span).min(2.0 * self.width);
+        }
+        (self.processed, self.rolled_back, self.moved) = (stats.processed, stats.rolled_back, 0.0);
+    }
 }
 
 /// A spare vector, or a new one.
@@ -691,8 +746,8 @@ pub struct Worker<M: Model> {
     received_ops: i64,
     uncommitted: usize,
     gvt: Floor,
-    /// The optimism window when none is set: a few GVT rounds' worth of progress.
-    auto_window: f64,
+    /// The optimism window when none is set.
+    auto_window: AutoWindow,
     round: u64,
     stats: TwStats,
     committed_stats: MessageStats,
@@ -780,7 +835,7 @@ impl<M: Model> Worker<M> {
             received_ops: 0,
             uncommitted: 0,
             gvt: Floor::NEG_INFINITY,
-            auto_window: f64::INFINITY,
+            auto_window: AutoWindow::new(),
             round: 0,
             stats: TwStats {
                 workers: 1,
@@ -1655,14 +1710,13 @@ impl<M: Model> Worker<M> {
         let interval = cfg.interval(threads::place().1);
         // uncommitted batches past which a worker runs only final ones
         let ahead = 2 * interval as usize;
-        let mut processed_then = self.stats.processed;
         self.ship = ship;
         self.final_ok = cfg.final_batches && fabric.shares_floors();
         self.flush(fabric);
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
-            let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window);
+            let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window.width);
             let mut limit = until.min(window);
             // short bursts publish floors often, so that the others' batches can run as final
             // (8 against 4: 2 workers at 10^5 balls to t = 0.5 ran 4-5 % faster in 13 of 18
@@ -1732,15 +1786,13 @@ impl<M: Model> Worker<M> {
                 Ok(Reduction {
                     floor: gvt, sweep, ..
                 }) => {
-                    if self.gvt.t.is_finite() && gvt.t.is_finite() && gvt.t > self.gvt.t {
-                        self.auto_window = auto_window(
-                            self.auto_window,
-                            gvt.t - self.gvt.t,
-                            self.stats.processed - processed_then,
-                            window_span(self.heap.len()),
-                        );
-                    }
-                    processed_then = self.stats.processed;
+                    let moved = if self.gvt.t.is_finite() && gvt.t.is_finite() {
+                        gvt.t - self.gvt.t
+                    } else {
+                        0.0
+                    };
+                    self.auto_window
+                        .after_round(moved, self.heap.len(), &self.stats);
                     self.gvt = gvt;
                     let batches = self.fossil_collect(model, gvt, sweep > 0);
                     self.round += 1;
@@ -1831,24 +1883,66 @@ mod tests {
 
     #[test]
     fn the_optimism_window_follows_the_rate_of_progress_not_the_rounds() {
+        let stats = |processed, rolled_back| TwStats {
+            processed,
+            rolled_back,
+            ..TwStats::default()
+        };
         // one round after 1024 batches or 16 rounds after 64 each: the same window
-        let one = auto_window(f64::INFINITY, 0.016, 1024, 1024.0);
-        let mut w = one;
-        for _ in 0..16 {
-            w = auto_window(w, 0.001, 64, 1024.0);
+        let mut one = AutoWindow::new();
+        one.after_round(0.016, 10, &stats(1024, 0));
+        let mut many = AutoWindow::new();
+        many.after_round(0.016, 10, &stats(1024, 0));
+        for k in 1..=16 {
+            many.after_round(0.001, 10, &stats(1024 + 64 * k, 0));
         }
-        assert!(
-            (one - 0.016).abs() < 1e-12 && (w - one).abs() < 1e-12,
-            "{one} {w}"
-        );
+        assert!((one.width - 0.016).abs() < 1e-12, "{}", one.width);
+        assert!((many.width - one.width).abs() < 1e-12, "{}", many.width);
         // it narrows at once where progress slows, and widens at most twofold a round
-        assert!((auto_window(one, 0.0016, 1024, 1024.0) - 0.0016).abs() < 1e-12);
-        assert_eq!(auto_window(0.01, 1.0, 1024, 1024.0), 0.02);
-        // a worker that ran nothing is counted as having run one batch
-        assert_eq!(auto_window(f64::INFINITY, 0.5, 0, 1024.0), 512.0);
+        one.after_round(0.0016, 10, &stats(2048, 0));
+        assert!((one.width - 0.0016).abs() < 1e-12);
+        one.after_round(1.0, 10, &stats(3072, 0));
+        assert!((one.width - 0.0032).abs() < 1e-12);
+        // a worker that ran few batches keeps its window until it has run enough to tell the
+        // rate; a sample in which GVT did not move leaves the width
+        let mut slow = AutoWindow::new();
+        slow.after_round(0.5, 10, &stats(100, 0));
+        assert_eq!(slow.width, f64::INFINITY);
+        slow.after_round(0.5, 10, &stats(256, 0));
+        assert_eq!(slow.width, 4.0);
+        slow.after_round(0.0, 10, &stats(1024, 0));
+        assert_eq!(slow.width, 4.0);
         // the span: one batch per pending message, within bounds
         let spans = [10, 5000, 100_000].map(window_span);
         assert_eq!(spans, [1024.0, 5000.0, 8192.0]);
+    }
+
+    #[test]
+    fn rollbacks_narrow_the_optimism_window_and_their_absence_widens_it_back() {
+        let mut w = AutoWindow::new();
+        let (mut processed, mut rolled_back) = (0, 0);
+        let mut round = |w: &mut AutoWindow, ran: u64, undone: u64| {
+            processed += ran;
+            rolled_back += undone;
+            let stats = TwStats {
+                processed,
+                rolled_back,
+                ..TwStats::default()
+            };
+            w.after_round(1.0, 2048, &stats);
+            w.scale
+        };
+        // a quarter rolled back halves the scale, down to 1/16; less doubles it back to 1
+        let scales: Vec<f64> = [300, 250, 400, 1000, 1000, 100, 0, 0, 0, 0]
+            .into_iter()
+            .map(|undone| round(&mut w, 1000, undone))
+            .collect();
+        assert_eq!(
+            scales,
+            [0.5, 0.25, 0.125, 0.0625, 0.0625, 0.125, 0.25, 0.5, 1.0, 1.0]
+        );
+        // the width follows: 1,000 batches moved GVT by 1, the span is 2,048
+        assert!((w.width - 2.048).abs() < 1e-12, "{}", w.width);
     }
 
     #[test]
