@@ -21,6 +21,7 @@
 //! States are `Clone` and kept small so an optimistic executor can save and restore them; each
 //! object's send counter (which names its messages) lives beside its state for the same reason.
 
+mod led_heap;
 pub mod queue;
 pub mod sequential;
 pub mod time_warp;

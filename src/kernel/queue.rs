@@ -3,6 +3,7 @@
 //! later ones to a large heap, and the next message is the smaller of the two tiers' next.
 //! Which tier an item is in never changes the order, only the cost.
 
+use super::led_heap::LedHeap;
 use dary_heap::QuaternaryHeap;
 
 /// Run items sorted again with fresh ones however few these are (beyond it, only four per fresh
@@ -20,6 +21,9 @@ pub trait Ranked: Ord {
     fn rank(&self) -> [u64; 4];
     /// Whether `self` and `o` belong to one instant.
     fn same_instant(&self, o: &Self) -> bool;
+    /// An integer that never orders two items against their own order: a greater lead means
+    /// a greater item, and items of equal leads compare themselves.
+    fn lead(&self) -> u64;
 }
 
 /// Sorts `v` ascending: by rank when its items are many and of one instant.
@@ -125,14 +129,14 @@ impl<T: Ranked> Instant<T> {
 /// Pending items, greatest first (as `BinaryHeap`: the executors reverse their order).
 pub struct Queue<T: Ranked> {
     instant: Instant<T>,
-    later: QuaternaryHeap<T>,
+    later: LedHeap<T>,
 }
 
 impl<T: Ranked> Default for Queue<T> {
     fn default() -> Self {
         Queue {
             instant: Instant::default(),
-            later: QuaternaryHeap::new(),
+            later: LedHeap::default(),
         }
     }
 }
@@ -145,7 +149,7 @@ impl<T: Ranked> Queue<T> {
                 fresh: Vec::with_capacity(n),
                 ..Instant::default()
             },
-            later: QuaternaryHeap::with_capacity(n),
+            later: LedHeap::with_capacity(n),
         }
     }
 
@@ -220,6 +224,9 @@ mod tests {
         fn same_instant(&self, _: &Self) -> bool {
             true
         }
+        fn lead(&self) -> u64 {
+            u64::from(*self)
+        }
     }
 
     /// An item of instant `.0`, ordered by `.1` within it.
@@ -232,6 +239,9 @@ mod tests {
         }
         fn same_instant(&self, o: &Self) -> bool {
             self.0 == o.0
+        }
+        fn lead(&self) -> u64 {
+            u64::from(self.0)
         }
     }
 
@@ -339,6 +349,9 @@ mod tests {
         }
         fn same_instant(&self, _: &Self) -> bool {
             false
+        }
+        fn lead(&self) -> u64 {
+            0
         }
     }
 

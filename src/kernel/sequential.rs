@@ -40,6 +40,10 @@ impl<M> Ranked for Item<M> {
     fn same_instant(&self, o: &Self) -> bool {
         self.0.time.key == o.0.time.key
     }
+    fn lead(&self) -> u64 {
+        // the earlier, the greater
+        !self.0.time.key.time_bits()
+    }
 }
 
 /// Runs a model's objects one batch at a time in virtual-time order.

@@ -461,6 +461,10 @@ impl<Msg> Ranked for Item<Msg> {
     fn same_instant(&self, o: &Self) -> bool {
         self.p.time.key == o.p.time.key
     }
+    fn lead(&self) -> u64 {
+        // the earlier, the greater
+        !self.p.time.key.time_bits()
+    }
 }
 
 /// A message an uncommitted batch sent, as its sender remembers it to annul it.
