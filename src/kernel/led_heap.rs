@@ -148,23 +148,8 @@ impl<T: Ranked> LedHeap<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::queue::tests::At;
     use proptest::prelude::*;
-
-    /// Ordered by `.0` then `.1`; its lead is `.0`, so equal leads compare the items.
-    #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-    struct Two(u8, u16);
-
-    impl Ranked for Two {
-        fn rank(&self) -> [u64; 4] {
-            [0, 0, 0, u64::from(self.1)]
-        }
-        fn same_instant(&self, o: &Self) -> bool {
-            self.0 == o.0
-        }
-        fn lead(&self) -> u64 {
-            u64::from(self.0)
-        }
-    }
 
     proptest! {
         /// Pushes, pops and a retain in any mix give what a sorted list of the same items
@@ -175,11 +160,11 @@ mod tests {
             drop_odd in any::<bool>(),
         ) {
             let mut heap = LedHeap::with_capacity(4);
-            let mut model: Vec<Two> = Vec::new();
+            let mut model: Vec<At> = Vec::new();
             for (i, &(push, a, b)) in ops.iter().enumerate() {
                 if push || model.is_empty() {
-                    heap.push(Two(a, b));
-                    model.push(Two(a, b));
+                    heap.push(At(a, u32::from(b)));
+                    model.push(At(a, u32::from(b)));
                 } else {
                     model.sort_unstable();
                     prop_assert_eq!(heap.pop(), model.pop());
@@ -191,11 +176,11 @@ mod tests {
                 prop_assert_eq!(heap.len(), model.len());
                 prop_assert_eq!(heap.peek(), model.iter().max());
             }
-            let mut held: Vec<Two> = heap.iter().copied().collect();
+            let mut held: Vec<At> = heap.iter().copied().collect();
             held.sort_unstable();
             model.sort_unstable();
             prop_assert_eq!(&held, &model);
-            let drained: Vec<Two> = std::iter::from_fn(|| heap.pop()).collect();
+            let drained: Vec<At> = std::iter::from_fn(|| heap.pop()).collect();
             prop_assert_eq!(drained, model.into_iter().rev().collect::<Vec<_>>());
         }
     }

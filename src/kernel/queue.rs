@@ -213,7 +213,7 @@ impl<T: Ranked> Queue<T> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use proptest::prelude::*;
 
@@ -231,7 +231,7 @@ mod tests {
 
     /// An item of instant `.0`, ordered by `.1` within it.
     #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-    struct At(u8, u32);
+    pub(crate) struct At(pub u8, pub u32);
 
     impl Ranked for At {
         fn rank(&self) -> [u64; 4] {
