@@ -659,6 +659,8 @@ where
                 });
             }
             loop {
+                // read before the drain: every chunk of a worker counted as ended is in the
+                // channel by then, so the drain after the last count leaves none behind
                 let done = finished.load(Ordering::Acquire) == workers_here;
                 for chunk in rx.try_iter() {
                     collector.take(model, total, chunk, sink, failed);
@@ -672,9 +674,6 @@ where
                 std::thread::park_timeout(COLLECTOR_NAP);
             }
         });
-        for chunk in rx.try_iter() {
-            collector.take(model, total, chunk, sink, failed);
-        }
     }
 }
 
