@@ -98,8 +98,12 @@ impl<T: Ranked> LedHeap<T> {
             }
             kept
         });
-        for i in (0..self.entries.len()).rev() {
-            self.sift_down(i);
+        // only nodes with children can be out of place
+        let n = self.entries.len();
+        if n > 1 {
+            for i in (0..=(n - 2) / D).rev() {
+                self.sift_down(i);
+            }
         }
     }
 

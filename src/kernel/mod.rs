@@ -230,6 +230,13 @@ impl<M> Pending<M> {
             .then(self.env.seq.cmp(&o.env.seq))
     }
 
+    /// The time as an integer that orders messages of different times as [`Pending::order`]
+    /// does (the lead of a pending set's entry, [`queue::Ranked::lead`]).
+    #[inline]
+    pub fn lead(&self) -> u64 {
+        self.time.key.time_bits()
+    }
+
     /// Integers that order messages of one key as [`Pending::order`] does, then by `uid`:
     /// generation and receiver, priority and sender, sequence, `uid`.
     pub fn rank(&self, uid: u64) -> [u64; 4] {

@@ -41,8 +41,7 @@ impl<M> Ranked for Item<M> {
         self.0.time.key == o.0.time.key
     }
     fn lead(&self) -> u64 {
-        // the earlier, the greater
-        !self.0.time.key.time_bits()
+        !self.0.lead()
     }
 }
 

@@ -462,8 +462,7 @@ impl<Msg> Ranked for Item<Msg> {
         self.p.time.key == o.p.time.key
     }
     fn lead(&self) -> u64 {
-        // the earlier, the greater
-        !self.p.time.key.time_bits()
+        !self.p.lead()
     }
 }
 
