@@ -68,6 +68,11 @@ impl<T: Ranked> LedHeap<T> {
         self.entries.first().map(|e| self.item(e.1))
     }
 
+    /// The greatest item's lead, read without the item.
+    pub fn peek_lead(&self) -> Option<u64> {
+        self.entries.first().map(|e| e.0)
+    }
+
     /// Takes the greatest item.
     pub fn pop(&mut self) -> Option<T> {
         let last = self.entries.pop()?;

@@ -162,9 +162,17 @@ impl<T: Ranked> Queue<T> {
         }
     }
 
-    /// Whether the next item is the large heap's.
+    /// Whether the next item is the large heap's: by the leads alone, unless they are equal
+    /// (the heap's next item is then read, and compared).
     fn later_first(&self) -> bool {
-        self.later.peek() > self.instant.top()
+        let Some(lead) = self.later.peek_lead() else {
+            return false;
+        };
+        match self.instant.top() {
+            None => true,
+            Some(i) if i.lead() != lead => lead > i.lead(),
+            i => self.later.peek() > i,
+        }
     }
 
     /// The next item.

@@ -1193,8 +1193,11 @@ impl<M: Model> Worker<M> {
         let (input, env) = first.into_input();
         inputs.push(input);
         batch.push(env);
+        // the object of the message after the batch: its record loads while the batch runs
+        let mut next = None;
         while let Some(top) = self.heap.peek() {
             if top.p.time != time || top.p.to != to {
+                next = Some(top.p.to);
                 break;
             }
             let it = self.heap.pop().expect("a top");
@@ -1232,9 +1235,9 @@ impl<M: Model> Worker<M> {
                 inputs.clear();
             }
         }
-        // the next batch's object, most likely: its record loads while this batch runs
-        if let Some(next) = self.heap.peek() {
-            prefetch_all(&self.lps[self.placement.local(next.p.to)]);
+        // the next batch's object, most likely (a local one: its message is here)
+        if let Some(next) = next {
+            prefetch_all(&self.lps[self.placement.local(next)]);
         }
         // a batch run as final saves nothing, and asks nothing of the model for it
         let saved = (!run_final).then(|| self.save_state(model, to, li));
