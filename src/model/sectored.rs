@@ -326,11 +326,25 @@ const KIND_NAMES: [&str; 9] = [
 pub struct Passage {
     /// The ball.
     pub ball: u32,
-    /// For an entry, the version of the ball's trajectory it was computed from; `None` for a
-    /// departure.
-    pub entry: Option<u64>,
+    /// For an entry, the version of the ball's trajectory it was computed from; [`DEPARTS`]
+    /// for a departure (a word, not an `Option` of one, so that a passage takes 40 bytes, not
+    /// 48: a sector's state is mostly passages, and Time Warp copies it before each batch it
+    /// may undo).
+    entry: u64,
     /// The messages to the sector itself and to the ball.
     pub sent: SentPair,
+}
+
+/// [`Passage`]'s `entry` of a departure: no trajectory has this version (one ball would
+/// have to change course 2^64 - 1 times).
+const DEPARTS: u64 = u64::MAX;
+
+impl Passage {
+    /// For an entry, the version of the ball's trajectory it was computed from; `None` for a
+    /// departure.
+    pub fn entry(&self) -> Option<u64> {
+        (self.entry != DEPARTS).then_some(self.entry)
+    }
 }
 
 /// The sectors a ball's disk touches: rarely more than four, kept inline so that saving the
@@ -874,7 +888,7 @@ impl Sectored {
         time: VTime,
     ) -> Passage {
         debug_assert_eq!(me, ctx.me(), "a sector schedules its own passages");
-        let version = entry.as_ref().map(|e| e.version);
+        let version = entry.as_ref().map_or(DEPARTS, |e| e.version);
         let sent = match entry {
             Some(info) => {
                 let entering = |info| SecMsg::SectorEntry {
@@ -968,11 +982,11 @@ impl Sectored {
                 SecMsg::SectorEntry { ball, info, .. } => {
                     let Some(k) = planned
                         .iter()
-                        .position(|p| p.ball == *ball && p.entry.is_some())
+                        .position(|p| p.ball == *ball && p.entry != DEPARTS)
                     else {
                         continue;
                     };
-                    let version = planned.swap_remove(k).entry;
+                    let version = planned.swap_remove(k).entry();
                     let info = info
                         .as_ref()
                         .expect("a sector's own entry carries the trajectory");
@@ -1011,7 +1025,7 @@ impl Sectored {
                     }
                     if planned
                         .iter()
-                        .any(|p| p.ball == *ball && p.entry == Some(info.version))
+                        .any(|p| p.ball == *ball && p.entry == info.version)
                     {
                         continue; // this entry is planned already
                     }
@@ -1142,6 +1156,12 @@ impl Model for Sectored {
 mod tests {
     use super::*;
     use crate::scenario::builtin::{build, Params};
+
+    #[test]
+    fn a_passage_takes_forty_bytes() {
+        // five words: a sector's state, which Time Warp copies, is mostly passages
+        assert_eq!(std::mem::size_of::<Passage>(), 40);
+    }
 
     #[test]
     fn a_state_cloned_into_another_equals_its_source() {
