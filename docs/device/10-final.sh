@@ -2,15 +2,8 @@
 # Twenty-first session, fifth call: the session's final code (cf979ca, with and without the `mpi`
 # feature) against the nineteenth session's fifth-call binary (a619b3e, `mpi`), 10^5 balls to
 # t = 0.5, round robin: the sequential engine and 2 and 16 workers.
-set -u
-O=$1; D=$PWD/.dev/run; chmod +x $D/*
-R=$O/results.tsv; : > $R
-exec > >(tee -a $O/log.txt) 2>&1
-r() { local l=$1 t=$2; shift 2
-  local j; j=$(timeout $t "$@" 2>$O/err.tmp | tail -1)
-  printf '%s\t%s\n' "$l" "${j:-{\"failed\":true\}}" >> $R
-  printf '%-30s %s\n' "$l" "$(echo "$j" | grep -o '"wall_seconds":[0-9.]*\|"final_state_digest":"[0-9a-f]*"\|"gvt_rounds":[0-9]*\|"efficiency":[0-9.]*' | tr '\n' ' ')"
-  [ -s $O/err.tmp ] && head -c 600 $O/err.tmp; }
+. "$(dirname "$0")/lib.sh"
+D=$PWD/.dev/run; chmod +x $D/*
 G="--balls 99856 --until 0.5 --sectors auto --json --quiet"
 date +%T
 BINS=(old cur cur_mpi)

@@ -2,16 +2,8 @@
 # Twenty-first session: the committed window rule and slab heap (.dev/run/new, d2b1b65) on 16 cores,
 # against the nineteenth session's fifth-call binary (.dev/run/old, span one batch per object),
 # plus the steady state (to t = 1.5) and 2 cores carved out with taskset.
-set -u
-O=$1; B=$PWD/.dev/run/new; OLD=$PWD/.dev/run/old; chmod +x $B $OLD
-R=$O/results.tsv; : > $R
-exec > >(tee -a $O/log.txt) 2>&1
-MPI="mpirun --allow-run-as-root --oversubscribe --bind-to none --mca btl self,vader --mca pml ob1 --mca btl_vader_single_copy_mechanism none"
-r() { local l=$1 t=$2; shift 2
-  local j; j=$(timeout $t "$@" 2>$O/err.tmp | tail -1)
-  printf '%s\t%s\n' "$l" "${j:-{\"failed\":true\}}" >> $R
-  printf '%-30s %s\n' "$l" "$(echo "$j" | grep -o '"wall_seconds":[0-9.]*\|"final_state_digest":"[0-9a-f]*"\|"gvt_rounds":[0-9]*\|"efficiency":[0-9.]*' | tr '\n' ' ')"
-  [ -s $O/err.tmp ] && head -c 600 $O/err.tmp; }
+. "$(dirname "$0")/lib.sh"
+B=$PWD/.dev/run/new; OLD=$PWD/.dev/run/old; chmod +x $B $OLD
 G="--sectors auto --json --quiet"
 lscpu | grep -E 'Model name|^CPU\(s\)|Thread|Socket|NUMA node\(s\)'; free -g | head -2; date +%T
 for k in 1 2; do

@@ -2,15 +2,8 @@
 # Twenty-first session, second call: the committed code (.dev/run/new, d2b1b65) against the nineteenth
 # session's fifth-call binary (.dev/run/old) in alternating pairs, and what the Time Warp executor
 # costs per batch on one dedicated core (1 worker: all batches final; --tw-pure: none).
-set -u
-O=$1; B=$PWD/.dev/run/new; OLD=$PWD/.dev/run/old; chmod +x $B $OLD
-R=$O/results.tsv; : > $R
-exec > >(tee -a $O/log.txt) 2>&1
-r() { local l=$1 t=$2; shift 2
-  local j; j=$(timeout $t "$@" 2>$O/err.tmp | tail -1)
-  printf '%s\t%s\n' "$l" "${j:-{\"failed\":true\}}" >> $R
-  printf '%-30s %s\n' "$l" "$(echo "$j" | grep -o '"wall_seconds":[0-9.]*\|"final_state_digest":"[0-9a-f]*"\|"gvt_rounds":[0-9]*\|"efficiency":[0-9.]*' | tr '\n' ' ')"
-  [ -s $O/err.tmp ] && head -c 600 $O/err.tmp; }
+. "$(dirname "$0")/lib.sh"
+B=$PWD/.dev/run/new; OLD=$PWD/.dev/run/old; chmod +x $B $OLD
 G="--sectors auto --json --quiet"
 date +%T
 for k in 1 2 3 4; do
