@@ -760,8 +760,10 @@ pub struct Worker<M: Model> {
     fault: Option<String>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
-    /// Uncommitted batches in the order they ran (committed early from the front).
-    log: Log<Done<M>>,
+    /// Uncommitted batches in the order they ran (committed early from the front), each
+    /// record boxed: the log's slots stay small, and a commit moves a pointer, not the record
+    /// (moved out of the log and into the commit, a record was copied three times).
+    log: Log<Box<Done<M>>>,
     /// The floor this worker published last (with final batches only).
     published: Floor,
     /// Whether batches may run as final ([`TwConfig::final_batches`]).
@@ -1036,7 +1038,7 @@ impl<M: Model> Worker<M> {
         self.stats.rollbacks += 1;
         while self.last_time(li).is_some_and(|t| t >= time) {
             let lp = &mut self.lps[li];
-            let d = self.log.pop_last(&mut lp.history).expect("a batch to undo");
+            let d = *self.log.pop_last(&mut lp.history).expect("a batch to undo");
             self.uncommitted -= 1;
             self.stats.rolled_back += 1;
             let undone = std::mem::replace(&mut lp.state, d.pre_state);
@@ -1319,7 +1321,7 @@ impl<M: Model> Worker<M> {
                 output,
                 into_past,
             };
-            self.log.push(&mut lp.history, li as u32, done);
+            self.log.push(&mut lp.history, li as u32, Box::new(done));
             self.uncommitted += 1;
             self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
             for (n, p) in (first + 1..).zip(sent.drain(..)) {
@@ -1552,7 +1554,9 @@ impl<M: Model> Worker<M> {
     /// Commits one optimistic batch of local object `li`: counts it and its sends, frees its
     /// records, and keeps for the collector what its sinks see (`state` is the object's state
     /// after it, when observed).
-    fn commit(&mut self, li: usize, mut d: Done<M>, state: Option<M::State>) {
+    // the record stays in the box the log held: taken out, its 350 bytes would be copied
+    #[allow(clippy::boxed_local)]
+    fn commit(&mut self, li: usize, mut d: Box<Done<M>>, state: Option<M::State>) {
         self.count_committed(d.into_past.take(), d.batch.len(), d.cancel_calls as usize);
         // its cancellations are final now: those of messages here become retractions
         for h in &d.cancels {
