@@ -174,10 +174,12 @@ impl<T: Ranked> Queue<T> {
         let Some(lead) = self.later.peek_lead() else {
             return false;
         };
-        match self.instant.top() {
-            None => true,
-            Some(i) if i.lead() != lead => lead > i.lead(),
-            i => self.later.peek() > i,
+        let Some(i) = self.instant.top() else {
+            return true;
+        };
+        match i.lead().cmp(&lead) {
+            std::cmp::Ordering::Equal => self.later.peek() > Some(i),
+            o => o.is_lt(),
         }
     }
 
