@@ -16,12 +16,17 @@ pub fn prefetch<T>(r: &T) {
     let _ = r;
 }
 
-/// [`prefetch`] for every cache line of a record larger than one.
+/// [`prefetch`] for every cache line a record lies on: its first, then each line start within
+/// it (a record that does not start on a line's start reaches one line further than its size
+/// alone says).
 #[inline(always)]
 pub fn prefetch_all<T>(r: &T) {
+    prefetch(r);
     let base = std::ptr::from_ref(r).cast::<u8>();
-    for offset in (0..std::mem::size_of::<T>()).step_by(64) {
+    let mut offset = 64 - base as usize % 64;
+    while offset < std::mem::size_of::<T>() {
         // SAFETY: `offset` is within the record, so the pointer stays inside one allocation.
         prefetch(unsafe { &*base.add(offset) });
+        offset += 64;
     }
 }

@@ -4,6 +4,7 @@
 //! Which tier an item is in never changes the order, only the cost.
 
 use super::led_heap::LedHeap;
+use crate::engine::prefetch::prefetch_all;
 use dary_heap::QuaternaryHeap;
 
 /// Run items sorted again with fresh ones however few these are (beyond it, only four per fresh
@@ -29,10 +30,130 @@ pub trait Ranked: Ord {
 /// Sorts `v` ascending: by rank when its items are many and of one instant.
 fn sort<T: Ranked>(v: &mut [T]) {
     match v.first() {
-        Some(first) if v.len() >= SORT_BY_RANK && v.iter().all(|x| x.same_instant(first)) => {
-            v.sort_unstable_by_key(T::rank);
+        Some(first)
+            if v.len() >= SORT_BY_RANK
+                && u32::try_from(v.len()).is_ok()
+                && v.iter().all(|x| x.same_instant(first)) =>
+        {
+            sort_by_rank(v)
         }
         _ => v.sort_unstable(),
+    }
+}
+
+/// How many places ahead [`sort_part`] loads the item it will move.
+const PERMUTE_AHEAD: usize = 16;
+
+/// Items from which [`sort_by_rank`] first splits them into [`PARTS`] parts by their first rank
+/// words: so many items (88 bytes each in the sectored gas) are far larger than the caches.
+const SPLIT_FROM: usize = 1 << 15;
+
+/// The parts [`sort_by_rank`] splits many items into (a power of two): each part's items lie
+/// together then, and each cursor the split moves items to stays in cache.
+const PARTS: usize = 256;
+
+/// Sorts items of one instant (fewer than 2^32) by their ranks. Many items are first split in
+/// place into parts by the high bits of their first rank words (an American flag sort: every
+/// item is swapped once into the part it belongs to), then each part is sorted on its own, its
+/// items now close together ([`sort_part`]). The sectored gas's set-up holds millions of items,
+/// whose sort compared in place took a quarter of it.
+fn sort_by_rank<T: Ranked>(v: &mut [T]) {
+    let (lo, hi) = v.iter().fold((u64::MAX, 0), |(lo, hi), x| {
+        let first = x.rank()[0];
+        (lo.min(first), hi.max(first))
+    });
+    if v.len() < SPLIT_FROM || hi == lo {
+        sort_part(v);
+        return;
+    }
+    let bits = u64::BITS - (hi - lo).leading_zeros();
+    let shift = bits.saturating_sub(PARTS.trailing_zeros());
+    let part = |x: &T| ((x.rank()[0] - lo) >> shift) as usize;
+    let mut ends = [0usize; PARTS];
+    for x in v.iter() {
+        ends[part(x)] += 1;
+    }
+    let mut next = [0usize; PARTS];
+    let mut sum = 0;
+    for (n, e) in next.iter_mut().zip(ends.iter_mut()) {
+        *n = sum;
+        sum += *e;
+        *e = sum;
+    }
+    for b in 0..PARTS {
+        while next[b] < ends[b] {
+            let to = part(&v[next[b]]);
+            if to != b {
+                v.swap(next[b], next[to]);
+            }
+            next[to] += 1;
+            // the part's next place, for the next item that goes there (too many parts fill
+            // at once for the processor to see them as streams)
+            if let Some(x) = v.get(next[to]) {
+                prefetch_all(x);
+            }
+        }
+    }
+    let mut start = 0;
+    for end in ends {
+        sort_part(&mut v[start..end]);
+        start = end;
+    }
+}
+
+/// Sorts items of one instant (fewer than 2^32) by their ranks, moving each item once into
+/// place. The ranks are read once; where the first words span few values (one generation's
+/// items: the first word is generation and receiver), they are counted into buckets, and only
+/// each bucket (one receiver's few items) is sorted by the rest.
+fn sort_part<T: Ranked>(v: &mut [T]) {
+    if v.len() < 2 {
+        return;
+    }
+    let ranks: Vec<[u64; 4]> = v.iter().map(T::rank).collect();
+    let (lo, hi) = ranks
+        .iter()
+        .fold((u64::MAX, 0), |(lo, hi), r| (lo.min(r[0]), hi.max(r[0])));
+    let mut order: Vec<u32>;
+    if hi - lo < 4 * ranks.len() as u64 {
+        let mut next = vec![0u32; (hi - lo) as usize + 2];
+        for r in &ranks {
+            next[(r[0] - lo) as usize + 1] += 1;
+        }
+        for b in 1..next.len() {
+            next[b] += next[b - 1];
+        }
+        order = vec![0; ranks.len()];
+        for (i, r) in ranks.iter().enumerate() {
+            let slot = &mut next[(r[0] - lo) as usize];
+            order[*slot as usize] = i as u32;
+            *slot += 1;
+        }
+        // each bucket now ends where the next one started
+        let mut start = 0;
+        for &end in &next[..next.len() - 1] {
+            let bucket = &mut order[start..end as usize];
+            if bucket.len() > 1 {
+                bucket.sort_unstable_by_key(|&i| ranks[i as usize]);
+            }
+            start = end as usize;
+        }
+    } else {
+        order = (0..ranks.len() as u32).collect();
+        order.sort_unstable_by_key(|&i| ranks[i as usize]);
+    }
+    // the item for place i is at order[i], unless an earlier swap moved it: then follow where
+    // it went (as the standard library's `sort_by_cached_key` does)
+    for i in 0..order.len() {
+        // the items lie scattered and are large: load one a few places ahead of its turn
+        if let Some(&ahead) = order.get(i + PERMUTE_AHEAD) {
+            prefetch_all(&v[ahead as usize]);
+        }
+        let mut from = order[i] as usize;
+        while from < i {
+            from = order[from] as usize;
+        }
+        order[i] = from as u32;
+        v.swap(i, from);
     }
 }
 
@@ -287,6 +408,58 @@ pub(crate) mod tests {
             items.sort_unstable_by(|a, b| b.cmp(a));
             let got: Vec<At> = std::iter::from_fn(|| q.pop()).collect();
             prop_assert_eq!(got, items);
+        }
+    }
+
+    /// An item of one instant whose first rank word is `.0`: few values of it sort by buckets,
+    /// many by comparing the ranks.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+    struct Dense(u16, u32);
+
+    impl Ranked for Dense {
+        fn rank(&self) -> [u64; 4] {
+            [u64::from(self.0), 0, u64::from(self.1), 0]
+        }
+        fn same_instant(&self, _: &Self) -> bool {
+            true
+        }
+        fn lead(&self) -> u64 {
+            0
+        }
+    }
+
+    proptest! {
+        /// Ranks whose first words are dense (bucketed) or sparse (compared) sort the same.
+        #[test]
+        fn ranks_sort_as_the_items_do(
+            items in prop::collection::vec((any::<u16>(), 0u32..8), SORT_BY_RANK..4 * SORT_BY_RANK),
+            dense in any::<bool>(),
+        ) {
+            let mut v: Vec<Dense> = items
+                .iter()
+                .map(|&(a, b)| Dense(if dense { a % 40 } else { a }, b))
+                .collect();
+            let mut want = v.clone();
+            want.sort_unstable();
+            sort(&mut v);
+            prop_assert_eq!(v, want);
+        }
+    }
+
+    /// So many items that they are split into parts first: with first words spread wide
+    /// (sparse within each part) and narrow (bucketed), and with parts left empty.
+    #[test]
+    fn many_items_split_into_parts_sort_as_the_items_do() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        for spread in [u16::MAX, 4000, 3] {
+            let mut v: Vec<Dense> = (0..SPLIT_FROM + 999)
+                .map(|_| Dense(rng.gen_range(0..=spread), rng.gen_range(0..50)))
+                .collect();
+            let mut want = v.clone();
+            want.sort_unstable();
+            sort(&mut v);
+            assert_eq!(v, want, "first words up to {spread}");
         }
     }
 
