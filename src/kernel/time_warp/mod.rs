@@ -70,7 +70,7 @@ use super::{
     uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT,
     STATE_CLASSES,
 };
-use crate::engine::prefetch::prefetch_all;
+use crate::engine::prefetch::{prefetch, prefetch_all};
 use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -713,6 +713,11 @@ impl Placement {
         self.place[o as usize].1 as usize
     }
 
+    /// Starts loading where object `o` lives.
+    fn prefetch(&self, o: u32) {
+        prefetch(&self.place[o as usize]);
+    }
+
     /// Number of workers.
     pub fn workers(&self) -> usize {
         self.workers
@@ -1237,9 +1242,11 @@ impl<M: Model> Worker<M> {
                 inputs.clear();
             }
         }
-        // the next batch's object, most likely (a local one: its message is here)
+        // the next batch's object, most likely (a local one: its message is here): where it
+        // lives now, and its record once the handler has run (not at once: the record's place
+        // is itself a load, and the step would wait for it)
         if let Some(next) = next {
-            prefetch_all(&self.lps[self.placement.local(next)]);
+            self.placement.prefetch(next);
         }
         // a batch run as final saves nothing, and asks nothing of the model for it
         let saved = (!run_final).then(|| self.save_state(model, to, li));
@@ -1327,6 +1334,9 @@ impl<M: Model> Worker<M> {
             for (n, p) in (first + 1..).zip(sent.drain(..)) {
                 self.send(uid(to, n), p);
             }
+        }
+        if let Some(next) = next {
+            prefetch_all(&self.lps[self.placement.local(next)]);
         }
         self.spare.pending = sent;
         for op in ops.drain(..) {
