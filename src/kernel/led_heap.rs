@@ -92,17 +92,25 @@ impl<T: Ranked> LedHeap<T> {
         self.entries.len()
     }
 
-    /// Keeps only the items `keep` accepts.
+    /// Keeps only the items `keep` accepts. The slab is read in its own order, not the
+    /// entries' (a heap of a million items is far larger than the caches, and the entries
+    /// point all over it); the entries then look up only a bit per slot.
     pub fn retain(&mut self, mut keep: impl FnMut(&T) -> bool) {
-        let (slab, free) = (&mut self.slab, &mut self.free);
-        self.entries.retain(|&(_, s)| {
-            let kept = keep(slab[s as usize].as_ref().expect("a held slot"));
-            if !kept {
-                slab[s as usize] = None;
-                free.push(s);
+        let mut dropped = vec![0u64; self.slab.len().div_ceil(64)];
+        let mut any = false;
+        for (s, slot) in self.slab.iter_mut().enumerate() {
+            if slot.as_ref().is_some_and(|item| !keep(item)) {
+                *slot = None;
+                self.free.push(s as u32);
+                dropped[s / 64] |= 1 << (s % 64);
+                any = true;
             }
-            kept
-        });
+        }
+        if !any {
+            return;
+        }
+        self.entries
+            .retain(|&(_, s)| dropped[s as usize / 64] & (1 << (s % 64)) == 0);
         // only nodes with children can be out of place
         let n = self.entries.len();
         if n > 1 {
