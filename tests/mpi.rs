@@ -87,6 +87,42 @@ fn sectored_gas_on_ranks() {
     assert_same("gas", &["--balls", "64", "--sectors", "4"]);
 }
 
+/// Ranks learn each other's floors at every round that ends with nothing in flight, and run
+/// batches below them as final: some are, on 2 ranks, and the answer stays the sequential one.
+#[test]
+fn ranks_run_batches_as_final_below_each_others_floors() {
+    let args = [
+        "run",
+        "gas",
+        "--balls",
+        "900",
+        "--sectors",
+        "auto",
+        "--until",
+        "2",
+    ];
+    let mut seq = args.to_vec();
+    seq.extend(["--json", "--quiet", "--engine", "objects"]);
+    let want = poolsim(None, None, &seq);
+    let mut tw = args.to_vec();
+    tw.extend([
+        "--json",
+        "--quiet",
+        "--engine",
+        "time-warp",
+        "--workers",
+        "1",
+    ]);
+    let got = poolsim(Some(2), None, &tw);
+    assert_eq!(got["final_state_digest"], want["final_state_digest"]);
+    let t = &got["time_warp"];
+    let (fin, committed) = (
+        t["final_batches"].as_u64().unwrap(),
+        t["committed"].as_u64().unwrap(),
+    );
+    assert!(fin > 0 && fin < committed, "{fin} of {committed} final");
+}
+
 #[test]
 fn the_break_on_ranks() {
     assert_same("pool", &[]);

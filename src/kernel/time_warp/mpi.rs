@@ -12,9 +12,15 @@
 //! whatever the delay. Committed chunks of other ranks travel the same way to rank 0, whose
 //! collector feeds the sink. Only the first thread of a rank calls MPI, and never two at once
 //! (MPI is initialized with `Threading::Serialized`); no other network layer is involved.
+//!
+//! Batches run as final across ranks too. A round that ends with nothing in flight gives every
+//! rank the others' floors: between two exchanges a rank receives nothing from the others, so
+//! nothing it sends until the next one comes before its floor at that round. Below those
+//! floors, and below every op this rank has put in a parcel since, no op from another rank can
+//! come (the same reasoning as a thread's floor, with a round for an instant).
 
-use super::threads::ThreadReduce;
-use super::{Chunk, Fabric, Floor, Op, Reduction};
+use super::threads::{Slots, ThreadReduce};
+use super::{Bounds, Chunk, Fabric, Floor, Op, Reduction};
 use crate::kernel::Model;
 use mpi::collective::SystemOperation;
 use mpi::datatype::{Partition, PartitionMut};
@@ -24,15 +30,28 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::sync::{mpsc, Barrier, Mutex};
 
-/// The smallest of every rank's floor: each rank's words gathered, the minimum taken alike on
-/// every rank.
-fn all_min(world: &SimpleCommunicator, here: Floor) -> Floor {
+/// The smallest of every rank's floor, and of every other rank's than this one's: each rank's
+/// words gathered, the minimum taken alike on every rank.
+fn all_min(world: &SimpleCommunicator, here: Floor) -> (Floor, Floor) {
     let words = here.to_words();
     let mut all = vec![0u64; words.len() * world.size() as usize];
     world.all_gather_into(&words[..], &mut all[..]);
+    let me = world.rank() as usize;
     all.chunks(words.len())
         .map(Floor::from_words)
-        .fold(Floor::INFINITY, Floor::min)
+        .enumerate()
+        .fold(
+            (Floor::INFINITY, Floor::INFINITY),
+            |(all, others), (r, f)| (all.min(f), if r == me { others } else { others.min(f) }),
+        )
+}
+
+/// What bounds the ops of other ranks for this rank's workers.
+struct Far {
+    /// The other ranks' smallest floor at the last round that ended with nothing in flight.
+    ranks: Floor,
+    /// The smallest op this rank's workers put in a parcel since that round.
+    parcels: Floor,
 }
 
 /// This process's place among the MPI ranks: `(rank, ranks)`, or `(0, 1)` when MPI is not
@@ -63,7 +82,8 @@ pub struct MpiFabric<M: Model> {
     rank: usize,
     ranks: usize,
     per_rank: usize,
-    inboxes: Vec<Mutex<Vec<Op<M::Msg>>>>,
+    slots: Slots<M::Msg>,
+    far: Mutex<Far>,
     outgoing: Mutex<Vec<Vec<ParcelOf<M>>>>,
     reduce: ThreadReduce,
     barrier: Barrier,
@@ -89,7 +109,12 @@ where
             rank,
             ranks,
             per_rank,
-            inboxes: (0..per_rank).map(|_| Mutex::new(Vec::new())).collect(),
+            slots: Slots::new(per_rank),
+            // nothing is known of the others before the first round
+            far: Mutex::new(Far {
+                ranks: Floor::NEG_INFINITY,
+                parcels: Floor::INFINITY,
+            }),
             outgoing: Mutex::new((0..ranks).map(|_| Vec::new()).collect()),
             reduce: ThreadReduce::new(per_rank),
             barrier: Barrier::new(per_rank),
@@ -104,12 +129,9 @@ where
 
     fn deliver(&self, parcel: ParcelOf<M>) {
         match parcel {
-            Parcel::Ops(w, mut ops) => {
+            Parcel::Ops(w, ops) => {
                 let k = self.local(w).expect("parcels reach their rank");
-                self.inboxes[k]
-                    .lock()
-                    .expect("no thread panicked")
-                    .append(&mut ops);
+                self.slots.send(k, ops);
             }
             Parcel::Chunk(c) => {
                 if let Some(tx) = &*self.collector.lock().expect("no thread panicked") {
@@ -176,20 +198,48 @@ where
     M::State: Serialize + DeserializeOwned + Send,
     M::Output: Serialize + DeserializeOwned + Send,
 {
-    fn send(&self, _from: usize, to: usize, mut ops: Vec<Op<M::Msg>>) {
+    fn send(&self, _from: usize, to: usize, ops: Vec<Op<M::Msg>>) {
         match self.local(to) {
-            Some(k) => self.inboxes[k]
-                .lock()
-                .expect("no thread panicked")
-                .append(&mut ops),
-            None => self.outgoing.lock().expect("no thread panicked")[to / self.per_rank]
-                .push(Parcel::Ops(to, ops)),
+            Some(k) => self.slots.send(k, ops),
+            None => {
+                // under a floor the others read before the sender publishes its own higher one
+                let floor = ops.iter().map(Op::floor).fold(Floor::INFINITY, Floor::min);
+                let mut far = self.far.lock().expect("no thread panicked");
+                far.parcels = far.parcels.min(floor);
+                drop(far);
+                self.outgoing.lock().expect("no thread panicked")[to / self.per_rank]
+                    .push(Parcel::Ops(to, ops));
+            }
         }
     }
 
     fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
         let k = self.local(me).expect("a worker of this rank");
-        into.append(&mut self.inboxes[k].lock().expect("no thread panicked"));
+        self.slots.recv(k, into);
+    }
+
+    fn shares_floors(&self) -> bool {
+        true
+    }
+
+    fn publish(&self, me: usize, floor: Floor) {
+        let k = self.local(me).expect("a worker of this rank");
+        self.slots.publish(k, floor);
+    }
+
+    fn peers_floor(&self, me: usize) -> Option<Bounds> {
+        let k = self.local(me).expect("a worker of this rank");
+        let (others, mine) = self.slots.peers(k)?;
+        // read after the workers' floors: a parcel's op is under the far floor before its
+        // sender raises its own
+        let far = {
+            let f = self.far.lock().expect("no thread panicked");
+            f.ranks.min(f.parcels)
+        };
+        Some(Bounds {
+            any: others.min(mine).min(far),
+            messages: others.next_generation().min(mine).min(far),
+        })
     }
 
     fn reduce(&self, me: usize, local: Reduction) -> Reduction {
@@ -200,7 +250,15 @@ where
             let world = SimpleCommunicator::world();
             let mut g = here;
             world.all_reduce_into(&here.in_flight, &mut g.in_flight, SystemOperation::sum());
-            g.floor = all_min(&world, here.floor);
+            let others;
+            (g.floor, others) = all_min(&world, here.floor);
+            if g.in_flight == 0 {
+                // every op sent is in its receiver's floor now, the parcels' ones included
+                *self.far.lock().expect("no thread panicked") = Far {
+                    ranks: others,
+                    parcels: Floor::INFINITY,
+                };
+            }
             // stop requests and sweep requests in one reduction
             let mut flags = [0u64; 2];
             world.all_reduce_into(

@@ -134,22 +134,16 @@ impl Floors {
     }
 }
 
-/// Workers as threads of this process.
-pub struct ThreadFabric<M: Model> {
-    slots: Vec<Slot<M::Msg>>,
-    reduce: ThreadReduce,
-    /// GVT rounds asked for so far (by any worker): every worker with fewer behind it starts one.
-    rounds_asked: AtomicU64,
-    collector: mpsc::Sender<Chunk<M::State, M::Output>>,
+/// The inboxes of one process's workers and the floors that bound them, shared by the threads
+/// fabric and, within each rank, the MPI one.
+pub(super) struct Slots<Msg> {
+    slots: Vec<Slot<Msg>>,
 }
 
-impl<M: Model> ThreadFabric<M>
-where
-    M::Msg: Send,
-{
-    /// A fabric for `n` workers whose committed chunks go to `collector`.
-    pub fn new(n: usize, collector: mpsc::Sender<Chunk<M::State, M::Output>>) -> Self {
-        ThreadFabric {
+impl<Msg> Slots<Msg> {
+    /// Empty inboxes for `n` workers, whose floors know nothing yet.
+    pub(super) fn new(n: usize) -> Self {
+        Slots {
             slots: (0..n)
                 .map(|_| Slot {
                     inbox: Mutex::new(Vec::new()),
@@ -157,22 +151,13 @@ where
                     floors: Floors::new(Floor::NEG_INFINITY, Floor::INFINITY),
                 })
                 .collect(),
-            reduce: ThreadReduce::new(n),
-            rounds_asked: AtomicU64::new(0),
-            collector,
         }
     }
-}
 
-impl<M: Model> Fabric<M> for ThreadFabric<M>
-where
-    M::Msg: Send,
-    M::State: Send,
-    M::Output: Send,
-{
-    fn send(&self, _from: usize, to: usize, mut ops: Vec<Op<M::Msg>>) {
+    /// Puts `ops` in worker `k`'s inbox, its floor lowered to theirs.
+    pub(super) fn send(&self, k: usize, mut ops: Vec<Op<Msg>>) {
         let floor = ops.iter().map(Op::floor).fold(Floor::INFINITY, Floor::min);
-        let slot = &self.slots[to];
+        let slot = &self.slots[k];
         let mut inbox = slot.inbox.lock().expect("no thread panicked");
         if inbox.is_empty() {
             std::mem::swap(&mut *inbox, &mut ops);
@@ -184,8 +169,9 @@ where
         slot.full.store(true, Ordering::Release);
     }
 
-    fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
-        let slot = &self.slots[me];
+    /// Moves worker `k`'s inbox into `into`; the worker's own floor takes the inbox's over.
+    pub(super) fn recv(&self, k: usize, into: &mut Vec<Op<Msg>>) {
+        let slot = &self.slots[k];
         // ops sent since this worker looked are taken at its next look
         if !slot.full.load(Ordering::Acquire) {
             return;
@@ -202,6 +188,80 @@ where
         }
         let (own, waiting) = slot.floors.current();
         slot.floors.write(own.min(waiting), Floor::INFINITY);
+    }
+
+    /// Sets worker `k`'s own floor.
+    pub(super) fn publish(&self, k: usize, floor: Floor) {
+        let slot = &self.slots[k];
+        let _inbox = slot.inbox.lock().expect("no thread panicked");
+        let (_, waiting) = slot.floors.current();
+        slot.floors.write(floor, waiting);
+    }
+
+    /// For worker `k`: the smallest floor of the other workers and their inboxes, and the floor
+    /// of `k`'s own inbox, as they all stood at one instant; `None` if a change was being
+    /// written meanwhile.
+    pub(super) fn peers(&self, k: usize) -> Option<(Floor, Floor)> {
+        // an op is always under some floor: in its sender's until it is in an inbox, in the
+        // inbox's until its receiver takes it, and in its receiver's from then on; what waits
+        // for another worker reaches `k` only through what that worker does from there
+        let (mut changes, mut others, mut mine) = (0u64, Floor::INFINITY, Floor::INFINITY);
+        for (w, slot) in self.slots.iter().enumerate() {
+            let (seq, own, waiting) = slot.floors.read()?;
+            changes += seq;
+            if w == k {
+                mine = waiting;
+            } else {
+                others = others.min(own).min(waiting);
+            }
+        }
+        // counts only grow: the same sum on a second reading means no slot changed between
+        // its two readings, so all of them held at one instant between the two passes
+        let again: u64 = self
+            .slots
+            .iter()
+            .map(|slot| slot.floors.seq.load(Ordering::Acquire))
+            .sum();
+        (again == changes).then_some((others, mine))
+    }
+}
+
+/// Workers as threads of this process.
+pub struct ThreadFabric<M: Model> {
+    slots: Slots<M::Msg>,
+    reduce: ThreadReduce,
+    /// GVT rounds asked for so far (by any worker): every worker with fewer behind it starts one.
+    rounds_asked: AtomicU64,
+    collector: mpsc::Sender<Chunk<M::State, M::Output>>,
+}
+
+impl<M: Model> ThreadFabric<M>
+where
+    M::Msg: Send,
+{
+    /// A fabric for `n` workers whose committed chunks go to `collector`.
+    pub fn new(n: usize, collector: mpsc::Sender<Chunk<M::State, M::Output>>) -> Self {
+        ThreadFabric {
+            slots: Slots::new(n),
+            reduce: ThreadReduce::new(n),
+            rounds_asked: AtomicU64::new(0),
+            collector,
+        }
+    }
+}
+
+impl<M: Model> Fabric<M> for ThreadFabric<M>
+where
+    M::Msg: Send,
+    M::State: Send,
+    M::Output: Send,
+{
+    fn send(&self, _from: usize, to: usize, ops: Vec<Op<M::Msg>>) {
+        self.slots.send(to, ops);
+    }
+
+    fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
+        self.slots.recv(me, into);
     }
 
     fn reduce(&self, me: usize, local: Reduction) -> Reduction {
@@ -226,34 +286,11 @@ where
     }
 
     fn publish(&self, me: usize, floor: Floor) {
-        let slot = &self.slots[me];
-        let _inbox = slot.inbox.lock().expect("no thread panicked");
-        let (_, waiting) = slot.floors.current();
-        slot.floors.write(floor, waiting);
+        self.slots.publish(me, floor);
     }
 
     fn peers_floor(&self, me: usize) -> Option<Bounds> {
-        // an op is always under some floor: in its sender's until it is in an inbox, in the
-        // inbox's until its receiver takes it, and in its receiver's from then on; what waits
-        // for another worker reaches `me` only through what that worker does from there
-        let (mut changes, mut others, mut mine) = (0u64, Floor::INFINITY, Floor::INFINITY);
-        for (w, slot) in self.slots.iter().enumerate() {
-            let (seq, own, waiting) = slot.floors.read()?;
-            changes += seq;
-            if w == me {
-                mine = waiting;
-            } else {
-                others = others.min(own).min(waiting);
-            }
-        }
-        // counts only grow: the same sum on a second reading means no slot changed between
-        // its two readings, so all of them held at one instant between the two passes
-        let again: u64 = self
-            .slots
-            .iter()
-            .map(|slot| slot.floors.seq.load(Ordering::Acquire))
-            .sum();
-        (again == changes).then_some(Bounds {
+        self.slots.peers(me).map(|(others, mine)| Bounds {
             any: others.min(mine),
             messages: others.next_generation().min(mine),
         })
