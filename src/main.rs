@@ -118,7 +118,7 @@ struct RunArgs {
     #[arg(long = "gvt-interval")]
     gvt_interval: Option<u32>,
     /// Pure Time Warp: every batch runs optimistically, with its state saved, even one that
-    /// nothing can roll back any more (by default such a batch runs as final, on threads).
+    /// nothing can roll back any more (by default such a batch runs as final).
     #[arg(long = "tw-pure")]
     tw_pure: bool,
     /// Delay of NewVelocity messages (objects engines).

@@ -33,7 +33,9 @@
 //! A batch that comes before every op any other worker may still send its worker is final
 //! already: it runs without saving its object's state and commits at once (with the object's
 //! earlier batches), its output waiting for the first GVT round that passes it. Workers on
-//! threads publish floors for this ([`Fabric::peers_floor`]). Running such safe events without
+//! threads publish floors for this ([`Fabric::peers_floor`]); across MPI ranks, each GVT round
+//! that ends with nothing in flight tells every rank the others' floors (the `mpi` module). Running such
+//! safe events without
 //! optimistic bookkeeping is the idea of protocols that mix conservative and optimistic
 //! execution event by event (Jha and Bagrodia, "A unified framework for conservative and
 //! optimistic distributed simulation", PADS 1994; Jefferson and Barnes, "Virtual Time III",
@@ -51,7 +53,8 @@
 //! them at once ([`Fabric::round_due`]): a worker that runs mostly final batches, which cost
 //! less, would otherwise wait at every round for the others to run as many. What bounds a
 //! worker that runs ahead instead is its count of uncommitted batches: past two intervals'
-//! worth it runs only final batches until a round commits some.
+//! worth (across ranks, at least two of the threads' default interval) it runs only final
+//! batches until a round commits some.
 
 #[cfg(feature = "mpi")]
 pub mod mpi;
@@ -110,7 +113,7 @@ pub struct TwConfig {
     /// runs only batches at GVT; past four times this, the run stops with an error.
     pub max_uncommitted: usize,
     /// Whether a batch before every op the other workers may still send runs as final: without
-    /// saving its object's state, committed at once (threads only; see [`Fabric::peers_floor`]).
+    /// saving its object's state, committed at once (see [`Fabric::peers_floor`]).
     pub final_batches: bool,
 }
 
@@ -158,7 +161,7 @@ pub struct TwStats {
     /// later, so that its sends come at least a generation after them.
     pub final_uncancellable: u64,
     /// Of the others, batches committed between GVT rounds, as soon as nothing could undo
-    /// them any more (threads only).
+    /// them any more.
     pub committed_early: u64,
     /// Batches undone by rollbacks.
     pub rolled_back: u64,
@@ -378,7 +381,8 @@ pub trait Fabric<M: Model>: Sync {
     /// from its inbox lowers it to theirs).
     fn publish(&self, _me: usize, _floor: Floor) {}
     /// Floors below what other workers may still send worker `me`, when the fabric can tell:
-    /// the published floors and the ops waiting in inboxes, read at one instant.
+    /// the published floors and the ops waiting in inboxes of its process, read at one instant
+    /// (across ranks, with the bound the last complete round gave, read after them).
     fn peers_floor(&self, _me: usize) -> Option<Bounds> {
         None
     }
@@ -1160,7 +1164,7 @@ impl<M: Model> Worker<M> {
         }
         let by = self.final_by_bounds(time, to, cancellable);
         if by.is_none() {
-            // each try locks every worker's slot twice
+            // each try reads every worker's slot of this process twice
             self.bound_wait = self.placement.workers() as u32 - 1;
         }
         by
@@ -1729,8 +1733,9 @@ impl<M: Model> Worker<M> {
         let mut since = 0u32;
         let ranks = threads::place().1;
         let interval = cfg.interval(ranks);
-        // uncommitted batches past which a worker runs only final ones; across ranks as many as
-        // on threads, though rounds come more often there: a worker held back waits for a round,
+        // uncommitted batches past which a worker runs only final ones; across ranks at least
+        // as many as at the threads' default interval, though rounds come more often there: a
+        // worker held back waits for a round,
         // and a round across ranks is a collective of them all (held back past 512 batches, 2
         // ranks at 10^5 balls to t = 1 ran 7 % more rounds)
         let ahead = 2 * if ranks > 1 {
@@ -1739,6 +1744,8 @@ impl<M: Model> Worker<M> {
             interval
         } as usize;
         self.ship = ship;
+        // this run's fabric knows nothing of this worker yet: its first flush publishes
+        self.published = Floor::NEG_INFINITY;
         self.final_ok = cfg.final_batches && fabric.shares_floors();
         self.flush(fabric);
         let result = loop {

@@ -17,7 +17,11 @@
 //! rank the others' floors: between two exchanges a rank receives nothing from the others, so
 //! nothing it sends until the next one comes before its floor at that round. Below those
 //! floors, and below every op this rank has put in a parcel since, no op from another rank can
-//! come (the same reasoning as a thread's floor, with a round for an instant).
+//! come (the same reasoning as a thread's floor, with a round for an instant). This rests on
+//! two facts of the protocol: ops cross ranks only at the exchanges inside reductions, and no
+//! worker runs a batch between the first exchange of a round and the round's end (each stays
+//! in the round until nothing is in flight). A change to either, such as sending ops between
+//! rounds, breaks the bound.
 
 use super::threads::{Slots, ThreadReduce};
 use super::{Bounds, Chunk, Fabric, Floor, Op, Reduction};
@@ -142,8 +146,9 @@ where
     }
 
     /// Delivers every waiting parcel to its rank: one all-to-all of counts, one of bytes. Every
-    /// rank must call it the same number of times, from one thread at a time.
-    pub fn exchange(&self) {
+    /// rank must call it the same number of times, from one thread at a time. Returns how many
+    /// parcels of ops reached this rank.
+    pub fn exchange(&self) -> usize {
         let world = SimpleCommunicator::world();
         let parcels = std::mem::replace(
             &mut *self.outgoing.lock().expect("no thread panicked"),
@@ -170,6 +175,7 @@ where
             total += rcounts[r];
         }
         let mut recv = vec![0u8; (total as usize).max(1)];
+        let mut ops = 0;
         world.all_to_all_varcount_into(
             &Partition::new(&send[..], &counts[..], &displs[..]),
             &mut PartitionMut::new(&mut recv[..], &rcounts[..], &rdispls[..]),
@@ -181,9 +187,11 @@ where
             let bytes = &recv[rdispls[r] as usize..(rdispls[r] + rcounts[r]) as usize];
             let ps: Vec<ParcelOf<M>> = bincode::deserialize(bytes).expect("parcels deserialize");
             for p in ps {
+                ops += usize::from(matches!(p, Parcel::Ops(..)));
                 self.deliver(p);
             }
         }
+        ops
     }
 
     /// Stops handing chunks to the collector (its channel closes when the last sender goes).
@@ -246,13 +254,14 @@ where
         let k = self.local(me).expect("a worker of this rank");
         let here = self.reduce.reduce(k, local);
         if k == 0 {
-            self.exchange();
+            let delivered = self.exchange();
             let world = SimpleCommunicator::world();
             let mut g = here;
             world.all_reduce_into(&here.in_flight, &mut g.in_flight, SystemOperation::sum());
             let others;
             (g.floor, others) = all_min(&world, here.floor);
             if g.in_flight == 0 {
+                assert_eq!(delivered, 0, "a round with nothing in flight moves no ops");
                 // every op sent is in its receiver's floor now, the parcels' ones included
                 *self.far.lock().expect("no thread panicked") = Far {
                     ranks: others,
