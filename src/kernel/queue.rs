@@ -58,11 +58,15 @@ const PARTS: usize = 256;
 /// items now close together ([`sort_part`]). The sectored gas's set-up holds millions of items,
 /// whose sort compared in place took a quarter of it.
 fn sort_by_rank<T: Ranked>(v: &mut [T]) {
+    if v.len() < SPLIT_FROM {
+        sort_part(v);
+        return;
+    }
     let (lo, hi) = v.iter().fold((u64::MAX, 0), |(lo, hi), x| {
         let first = x.rank()[0];
         (lo.min(first), hi.max(first))
     });
-    if v.len() < SPLIT_FROM || hi == lo {
+    if hi == lo {
         sort_part(v);
         return;
     }

@@ -34,10 +34,9 @@
 //! already: it runs without saving its object's state and commits at once (with the object's
 //! earlier batches), its output waiting for the first GVT round that passes it. Workers on
 //! threads publish floors for this ([`Fabric::peers_floor`]); across MPI ranks, each GVT round
-//! that ends with nothing in flight tells every rank the others' floors (the `mpi` module). Running such
-//! safe events without
-//! optimistic bookkeeping is the idea of protocols that mix conservative and optimistic
-//! execution event by event (Jha and Bagrodia, "A unified framework for conservative and
+//! that ends with nothing in flight tells every rank the others' floors (the `mpi` module).
+//! Running such safe events without optimistic bookkeeping is the idea of protocols that mix
+//! conservative and optimistic execution event by event (Jha and Bagrodia, "A unified framework for conservative and
 //! optimistic distributed simulation", PADS 1994; Jefferson and Barnes, "Virtual Time III",
 //! ACM TOMACS 32(4), 2022). With one worker every batch is final.
 //!
@@ -290,6 +289,11 @@ impl<Msg> Op<Msg> {
         let (time, to) = self.place();
         Floor::of(time, to)
     }
+
+    /// The smallest floor of `ops` ([`Floor::INFINITY`] for none).
+    pub fn lowest(ops: &[Op<Msg>]) -> Floor {
+        ops.iter().map(Op::floor).fold(Floor::INFINITY, Floor::min)
+    }
 }
 
 /// The values a GVT round reduces over all workers.
@@ -360,6 +364,25 @@ pub struct Bounds {
     /// floor sends those only from the floor's next generation on
     /// ([`Floor::next_generation`]), and ops waiting for the asking worker come where they are.
     pub messages: Floor,
+}
+
+impl Bounds {
+    /// The bounds of a worker whose peers' floors (their own and their inboxes') are at
+    /// least `others` and whose own inbox's floor is `mine`.
+    pub fn of_peers(others: Floor, mine: Floor) -> Bounds {
+        Bounds {
+            any: others.min(mine),
+            messages: others.next_generation().min(mine),
+        }
+    }
+
+    /// These bounds, lowered to `floor` where they are above it.
+    pub fn below(self, floor: Floor) -> Bounds {
+        Bounds {
+            any: self.any.min(floor),
+            messages: self.messages.min(floor),
+        }
+    }
 }
 
 /// How workers reach each other: delivery of ops, reductions and the collector.
@@ -1735,9 +1758,8 @@ impl<M: Model> Worker<M> {
         let interval = cfg.interval(ranks);
         // uncommitted batches past which a worker runs only final ones; across ranks at least
         // as many as at the threads' default interval, though rounds come more often there: a
-        // worker held back waits for a round,
-        // and a round across ranks is a collective of them all (held back past 512 batches, 2
-        // ranks at 10^5 balls to t = 1 ran 7 % more rounds)
+        // worker held back waits for a round, and a round across ranks is a collective of them
+        // all (held back past 512 batches, 2 ranks at 10^5 balls to t = 1 ran 7 % more rounds)
         let ahead = 2 * if ranks > 1 {
             interval.max(THREADS_GVT_INTERVAL)
         } else {

@@ -211,7 +211,7 @@ where
             Some(k) => self.slots.send(k, ops),
             None => {
                 // under a floor the others read before the sender publishes its own higher one
-                let floor = ops.iter().map(Op::floor).fold(Floor::INFINITY, Floor::min);
+                let floor = Op::lowest(&ops);
                 let mut far = self.far.lock().expect("no thread panicked");
                 far.parcels = far.parcels.min(floor);
                 drop(far);
@@ -244,10 +244,7 @@ where
             let f = self.far.lock().expect("no thread panicked");
             f.ranks.min(f.parcels)
         };
-        Some(Bounds {
-            any: others.min(mine).min(far),
-            messages: others.next_generation().min(mine).min(far),
-        })
+        Some(Bounds::of_peers(others, mine).below(far))
     }
 
     fn reduce(&self, me: usize, local: Reduction) -> Reduction {

@@ -156,7 +156,7 @@ impl<Msg> Slots<Msg> {
 
     /// Puts `ops` in worker `k`'s inbox, its floor lowered to theirs.
     pub(super) fn send(&self, k: usize, mut ops: Vec<Op<Msg>>) {
-        let floor = ops.iter().map(Op::floor).fold(Floor::INFINITY, Floor::min);
+        let floor = Op::lowest(&ops);
         let slot = &self.slots[k];
         let mut inbox = slot.inbox.lock().expect("no thread panicked");
         if inbox.is_empty() {
@@ -290,10 +290,9 @@ where
     }
 
     fn peers_floor(&self, me: usize) -> Option<Bounds> {
-        self.slots.peers(me).map(|(others, mine)| Bounds {
-            any: others.min(mine),
-            messages: others.next_generation().min(mine),
-        })
+        self.slots
+            .peers(me)
+            .map(|(others, mine)| Bounds::of_peers(others, mine))
     }
 }
 
