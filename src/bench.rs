@@ -9,6 +9,7 @@
 
 use crate::engine::event_list::{EventList, Options};
 use crate::engine::Ignore;
+use crate::model::phold::ROSS_EVENTS_PER_SECOND_PER_CORE;
 use crate::scenario::builtin::{self, Params};
 use serde_json::json;
 use std::time::Instant;
@@ -487,21 +488,29 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             "{}",
             json!({"machine": m, "engine": "event-list", "rows": rows, "growth": growth,
                    "objects": objects, "sectored": sectored, "time_warp": time_warp,
-                   "phold": phold})
+                   "phold": phold,
+                   "phold_ross_events_per_second_per_core": ROSS_EVENTS_PER_SECOND_PER_CORE})
         );
     } else {
         println!();
+        println!(
+            "PHOLD beside ROSS's published record, {:.2} M committed events/s per core (504 \
+             billion/s on 1,966,080 Blue Gene/Q cores; Barnes et al., PADS 2013):",
+            ROSS_EVENTS_PER_SECOND_PER_CORE / 1e6
+        );
         for p in &phold {
             let workers = p.time_warp.as_ref().map_or(0, |t| t.workers);
             println!(
                 "PHOLD {} objects x 16 events, remote 0.1, {} partitions, end 20, {} ({} \
-                 workers): {} committed, {:.0} events/s, efficiency {:.3}, digest {}",
+                 workers): {} committed, {:.0} events/s, {:.2} M per core, efficiency {:.3}, \
+                 digest {}",
                 p.objects,
                 p.partitions,
                 p.engine,
                 workers,
                 p.committed,
                 p.events_per_second,
+                p.events_per_second_per_core / 1e6,
                 p.time_warp.as_ref().map_or(1.0, |t| t.efficiency()),
                 p.final_state_digest
             );

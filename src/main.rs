@@ -417,7 +417,8 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
     } else {
         println!(
             "PHOLD on {}, {} objects x {} events, remote {}, {} partitions, end {}: {} committed \
-             events in {:.3} s, {:.0} events/s, digest {}",
+             events in {:.3} s, {:.0} events/s ({:.2} M per core; ROSS's published record: \
+             {:.2} M per core), digest {}",
             report.engine,
             report.objects,
             report.events_per_object,
@@ -427,6 +428,8 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
             report.committed,
             report.wall_seconds,
             report.events_per_second,
+            report.events_per_second_per_core / 1e6,
+            poolsim::model::phold::ROSS_EVENTS_PER_SECOND_PER_CORE / 1e6,
             report.final_state_digest
         );
         if let Some(t) = &report.time_warp {

@@ -149,6 +149,8 @@ fn reverse_model_and_phold() {
         "--json",
     ]));
     assert!(p["committed"].as_u64().unwrap() > 0);
+    // the sequential kernel runs on one core
+    assert_eq!(p["events_per_second_per_core"], p["events_per_second"]);
     let again = json(&poolsim(&[
         "phold",
         "--objects",

@@ -153,6 +153,12 @@ impl Model for Phold {
     }
 }
 
+/// ROSS's published PHOLD record per core, in committed events per second: 504 billion events
+/// per second on 1,966,080 Blue Gene/Q cores (Barnes, Carothers, Jefferson and LaPre, "Warp
+/// speed: executing Time Warp on 1,966,080 cores", PADS 2013), the reference that PHOLD figures
+/// are set beside.
+pub const ROSS_EVENTS_PER_SECOND_PER_CORE: f64 = 504e9 / 1_966_080.0;
+
 /// What a PHOLD run did.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct PholdReport {
@@ -174,6 +180,10 @@ pub struct PholdReport {
     pub wall_seconds: f64,
     /// Committed events per second.
     pub events_per_second: f64,
+    /// Committed events per second per core: over every worker of every rank under Time Warp,
+    /// over the one thread of the sequential kernel (set beside
+    /// [`ROSS_EVENTS_PER_SECOND_PER_CORE`]).
+    pub events_per_second_per_core: f64,
     /// Hash of every object's final counts and random stream position: equal digests, equal runs.
     pub final_state_digest: String,
     /// Time Warp's statistics, under Time Warp.
@@ -218,6 +228,8 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
     };
     let wall = start.elapsed().as_secs_f64();
     let committed = stats.delivered;
+    let events_per_second = committed as f64 / wall.max(1e-9);
+    let cores = time_warp.as_ref().map_or(1, |t| t.workers.max(1));
     Ok(PholdReport {
         objects,
         events_per_object,
@@ -231,7 +243,8 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
         },
         committed,
         wall_seconds: wall,
-        events_per_second: committed as f64 / wall.max(1e-9),
+        events_per_second,
+        events_per_second_per_core: events_per_second / cores as f64,
         final_state_digest: fnv_hex(
             finals
                 .iter()
