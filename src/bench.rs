@@ -499,15 +499,18 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             ROSS_EVENTS_PER_SECOND_PER_CORE / 1e6
         );
         for p in &phold {
-            let workers = p.time_warp.as_ref().map_or(0, |t| t.workers);
+            let executor = match &p.time_warp {
+                Some(t) if t.workers == 1 => "1 worker".to_string(),
+                Some(t) => format!("{} workers", t.workers),
+                None => "sequential kernel".to_string(),
+            };
             println!(
-                "PHOLD {} objects x 16 events, remote 0.1, {} partitions, end 20, {} ({} \
-                 workers): {} committed, {:.0} events/s, {:.2} M per core, efficiency {:.3}, \
-                 digest {}",
+                "PHOLD {} objects x 16 events, remote 0.1, {} partitions, end 20, {} ({}): {} \
+                 committed, {:.0} events/s, {:.2} M per core, efficiency {:.3}, digest {}",
                 p.objects,
                 p.partitions,
                 p.engine,
-                workers,
+                executor,
                 p.committed,
                 p.events_per_second,
                 p.events_per_second_per_core / 1e6,
