@@ -97,16 +97,15 @@ impl<T: Ranked> LedHeap<T> {
     /// point all over it); the entries then look up only a bit per slot.
     pub fn retain(&mut self, mut keep: impl FnMut(&T) -> bool) {
         let mut dropped = vec![0u64; self.slab.len().div_ceil(64)];
-        let mut any = false;
+        let free_before = self.free.len();
         for (s, slot) in self.slab.iter_mut().enumerate() {
             if slot.as_ref().is_some_and(|item| !keep(item)) {
                 *slot = None;
                 self.free.push(s as u32);
                 dropped[s / 64] |= 1 << (s % 64);
-                any = true;
             }
         }
-        if !any {
+        if self.free.len() == free_before {
             return;
         }
         self.entries

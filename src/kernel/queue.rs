@@ -41,6 +41,11 @@ fn sort<T: Ranked>(v: &mut [T]) {
     }
 }
 
+/// The smallest and the largest of some first rank words (`(u64::MAX, 0)` for none).
+fn span(firsts: impl Iterator<Item = u64>) -> (u64, u64) {
+    firsts.fold((u64::MAX, 0), |(lo, hi), w| (lo.min(w), hi.max(w)))
+}
+
 /// How many places ahead [`sort_part`] loads the item it will move.
 const PERMUTE_AHEAD: usize = 16;
 
@@ -62,10 +67,7 @@ fn sort_by_rank<T: Ranked>(v: &mut [T]) {
         sort_part(v);
         return;
     }
-    let (lo, hi) = v.iter().fold((u64::MAX, 0), |(lo, hi), x| {
-        let first = x.rank()[0];
-        (lo.min(first), hi.max(first))
-    });
+    let (lo, hi) = span(v.iter().map(|x| x.rank()[0]));
     if hi == lo {
         sort_part(v);
         return;
@@ -114,9 +116,7 @@ fn sort_part<T: Ranked>(v: &mut [T]) {
         return;
     }
     let ranks: Vec<[u64; 4]> = v.iter().map(T::rank).collect();
-    let (lo, hi) = ranks
-        .iter()
-        .fold((u64::MAX, 0), |(lo, hi), r| (lo.min(r[0]), hi.max(r[0])));
+    let (lo, hi) = span(ranks.iter().map(|r| r[0]));
     let mut order: Vec<u32>;
     if hi - lo < 4 * ranks.len() as u64 {
         let mut next = vec![0u32; (hi - lo) as usize + 2];

@@ -36,9 +36,9 @@
 //! threads publish floors for this ([`Fabric::peers_floor`]); across MPI ranks, each GVT round
 //! that ends with nothing in flight tells every rank the others' floors (the `mpi` module).
 //! Running such safe events without optimistic bookkeeping is the idea of protocols that mix
-//! conservative and optimistic execution event by event (Jha and Bagrodia, "A unified framework for conservative and
-//! optimistic distributed simulation", PADS 1994; Jefferson and Barnes, "Virtual Time III",
-//! ACM TOMACS 32(4), 2022). With one worker every batch is final.
+//! conservative and optimistic execution event by event (Jha and Bagrodia, "A unified framework
+//! for conservative and optimistic distributed simulation", PADS 1994; Jefferson and Barnes,
+//! "Virtual Time III", ACM TOMACS 32(4), 2022). With one worker every batch is final.
 //!
 //! GVT (global virtual time) is found in synchronous rounds, as ROSS does: workers stop
 //! processing, drain their inboxes until a reduction says every op sent has been received,
@@ -809,6 +809,8 @@ pub struct Worker<M: Model> {
     message_bound: Floor,
     /// Batches to wait before asking the fabric for a new bound after a failed try.
     bound_wait: u32,
+    /// Workers of this process, whose slots each try reads (all workers but under MPI).
+    workers_here: u32,
     /// The last batch run as final: no message or anti-message may come at or before it.
     final_floor: Floor,
     /// The last batch run as final below every op another worker may send: no op at all, a
@@ -890,6 +892,7 @@ impl<M: Model> Worker<M> {
             final_bound: Floor::NEG_INFINITY,
             message_bound: Floor::NEG_INFINITY,
             bound_wait: 0,
+            workers_here: workers as u32,
             final_floor: Floor::NEG_INFINITY,
             cancel_floor: Floor::NEG_INFINITY,
             high: None,
@@ -1188,7 +1191,7 @@ impl<M: Model> Worker<M> {
         let by = self.final_by_bounds(time, to, cancellable);
         if by.is_none() {
             // each try reads every worker's slot of this process twice
-            self.bound_wait = self.placement.workers() as u32 - 1;
+            self.bound_wait = self.workers_here - 1;
         }
         by
     }
@@ -1766,6 +1769,7 @@ impl<M: Model> Worker<M> {
             interval
         } as usize;
         self.ship = ship;
+        self.workers_here = (self.placement.workers() / ranks).max(1) as u32;
         // this run's fabric knows nothing of this worker yet: its first flush publishes
         self.published = Floor::NEG_INFINITY;
         self.final_ok = cfg.final_batches && fabric.shares_floors();
