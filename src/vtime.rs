@@ -13,6 +13,7 @@
 //! last fixed (the later of the two, extended by the pair), so every engine that holds the same
 //! trajectories computes the same key, however it found the collision.
 
+use crate::kernel::time::{Time, TIE_WORDS};
 use smallvec::SmallVec;
 use std::cmp::Ordering;
 
@@ -122,6 +123,29 @@ impl Key {
             Ordering::Equal => self.path.as_slice().cmp(&[p][..]),
             o => o,
         }
+    }
+}
+
+/// Keys as the kernel's virtual time: the path of pairs breaks the ties of an instant.
+impl Time for Key {
+    fn start(t: f64) -> Key {
+        Key::start(t)
+    }
+
+    #[inline]
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn depth(&self) -> usize {
+        self.path.len()
+    }
+
+    #[inline]
+    fn tie_words(&self, out: &mut [u64; TIE_WORDS]) -> usize {
+        let kept = self.path.len().min(TIE_WORDS);
+        out[..kept].copy_from_slice(&self.path[..kept]);
+        self.path.len()
     }
 }
 

@@ -293,7 +293,6 @@ fn memory_stays_flat_over_many_gvt_rounds() {
     use poolsim::kernel::time_warp::threads::TimeWarp;
     use poolsim::kernel::VTime;
     use poolsim::model::phold::{Phold, PholdConfig};
-    use poolsim::vtime::Key;
     let cfg = PholdConfig {
         objects: 512,
         events_per_object: 8,
@@ -310,7 +309,7 @@ fn memory_stays_flat_over_many_gvt_rounds() {
         gvt_interval: Some(512),
         ..TwConfig::default()
     };
-    let mut ex = TimeWarp::new(model, states, VTime::at(Key::start(0.0)), &worker_of, tw);
+    let mut ex = TimeWarp::new(model, states, VTime::start(0.0), &worker_of, tw);
     ex.run::<()>(200.0, &mut |_, _, _| Ok(())).unwrap();
     let stats = ex.tw_stats();
     assert!(stats.gvt_rounds >= 100, "{stats:?}");

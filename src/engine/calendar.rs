@@ -27,7 +27,7 @@
 //! orders the opened buckets by full [`Key`], so ties within an instant come out as DESIGN.md
 //! says whatever the bucket width.
 
-use super::prefetch::prefetch;
+use crate::kernel::prefetch::prefetch;
 use crate::vtime::Key;
 use std::cmp::Ordering;
 use std::collections::VecDeque;

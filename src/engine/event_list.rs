@@ -24,12 +24,12 @@
 
 use super::calendar::{Calendar, Entries, Place};
 use super::grid::Grid;
-use super::prefetch::{prefetch, prefetch_all};
 use super::{
     BallState, Event, EventCounts, EventKind, Fixed, Frame, InstantCap, Observer, Outcome,
     RunError, Span, Table, World,
 };
 use crate::geometry::Trajectory;
+use crate::kernel::prefetch::{prefetch, prefetch_all};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};

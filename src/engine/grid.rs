@@ -9,9 +9,9 @@
 //! another); when a cell fills up, every cell gets twice the slots. Fixed objects are listed once
 //! per cell they may reach, in compressed rows.
 
-use super::prefetch::prefetch;
 use super::Table;
 use crate::geometry::Vec2;
+use crate::kernel::prefetch::prefetch;
 
 const NIL: u32 = u32::MAX;
 

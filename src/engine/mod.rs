@@ -10,7 +10,6 @@ pub mod event_list;
 pub mod grid;
 pub mod objects;
 pub mod partition;
-pub mod prefetch;
 pub mod time_step;
 
 use crate::geometry::{Trajectory, Vec2};

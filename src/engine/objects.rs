@@ -13,7 +13,6 @@ use crate::kernel::{MessageStats, Model, VTime};
 use crate::model::pool::{BallInfo, NvDelay, Pool, PoolOutput, PoolState};
 use crate::model::sectored::{Layout, SecState, Sectored};
 use crate::scenario::Scenario;
-use crate::vtime::Key;
 
 /// The objects engine over one scenario: plain or sectored.
 pub enum Objects {
@@ -40,7 +39,7 @@ where
 {
     /// The sequential executor, or Time Warp with `tw` and the objects' workers `worker_of`.
     fn new(model: M, states: Vec<M::State>, start: f64, tw: Option<(TwConfig, Vec<u32>)>) -> Self {
-        let start = VTime::at(Key::start(start));
+        let start = VTime::start(start);
         match tw {
             None => Exec::Sequential(Box::new(Sequential::new(model, states, start))),
             Some((cfg, worker_of)) => Exec::TimeWarp(Box::new(TimeWarp::new(

@@ -13,74 +13,32 @@
 //! them as one batch ordered by message priority (thesis 4.3.1), then sender, then the sender's
 //! send sequence: never by address or hash order.
 //!
-//! Virtual time ([`VTime`]) is a [`Key`] and a generation: a message sent with zero delay while
-//! handling `(k, g)` arrives at `(k, g + 1)`, after the batch that sent it and before every other
-//! key of the instant; a message sent to an explicit key (a predicted collision) arrives there
-//! with generation 0. No message may go into the receiver's past.
+//! Virtual time ([`VTime`]) is the model's own [`Time`] and a generation: a message sent with
+//! zero delay while handling `(k, g)` arrives at `(k, g + 1)`, after the batch that sent it and
+//! before every later time; a message sent to an explicit time arrives there with generation 0.
+//! No message may go into the receiver's past.
 //!
 //! States are `Clone` and kept small so an optimistic executor can save and restore them; each
 //! object's send counter (which names its messages) lives beside its state for the same reason.
 
 mod led_heap;
+pub mod prefetch;
 pub mod queue;
 pub mod sequential;
+pub mod time;
 pub mod time_warp;
+
+pub use time::{PlainTime, Time, VTime};
 
 /// Pending messages an executor reserves room for per object (address space only until used,
 /// so that a pending set that grows to that size never copies itself into fresh pages): the
 /// sectored gas's set-up instant holds about 25 per object.
 pub const RESERVED_PER_OBJECT: usize = 32;
 
-use crate::vtime::Key;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::cmp::Ordering;
 use std::fmt::Debug;
-
-/// Virtual time: a key and the generation of zero-delay sends within it.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct VTime {
-    /// The key (time and pair path).
-    pub key: Key,
-    /// How many zero-delay hops after `key` this is.
-    pub gen: u32,
-}
-
-impl VTime {
-    /// The time of an explicit key, generation 0.
-    pub fn at(key: Key) -> VTime {
-        VTime { key, gen: 0 }
-    }
-
-    /// The time a zero-delay message sent now arrives.
-    pub fn next_gen(&self) -> VTime {
-        VTime {
-            key: self.key.clone(),
-            gen: self.gen + 1,
-        }
-    }
-
-    /// Simulation time.
-    pub fn t(&self) -> f64 {
-        self.key.t
-    }
-}
-
-impl Eq for VTime {}
-
-impl PartialOrd for VTime {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for VTime {
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.key
-            .cmp(&other.key)
-            .then_with(|| self.gen.cmp(&other.gen))
-    }
-}
 
 /// Names a sent message so that its sender can cancel it: the sender and its send sequence,
 /// which alone tell handles apart, and what an optimistic executor needs to reach the message
@@ -117,10 +75,10 @@ impl std::hash::Hash for Handle {
 }
 
 /// Names two messages a batch sent at one time, one right after the other, the first to the
-/// sender itself and the second to `other` (a collision's or a passage's pair): what tells
+/// sender itself and the second to `other` (an event both objects take part in): what tells
 /// their handles apart, in 24 bytes where the two handles take 80, for states that keep many.
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
-pub struct SentPair {
+pub struct SentTwo {
     /// The first message's send sequence (the second's is the next).
     seq: u64,
     /// The first message's transport name (the second's is the next), or 0 if unnamed.
@@ -129,8 +87,8 @@ pub struct SentPair {
     t: f64,
 }
 
-impl SentPair {
-    /// The handles of the pair object `from` sent: to itself, and to `other`.
+impl SentTwo {
+    /// The handles of the two messages object `from` sent: to itself, and to `other`.
     pub fn handles(&self, from: u32, other: u32) -> [Handle; 2] {
         let h = Handle {
             from,
@@ -165,6 +123,9 @@ pub const STATE_CLASSES: usize = 4;
 
 /// A simulation model for the kernel: message and state types and the objects' behaviour.
 pub trait Model {
+    /// The model's virtual time ([`PlainTime`] unless it orders the events of an instant
+    /// itself).
+    type Time: Time;
     /// Message payloads (serializable, so that Time Warp can carry them between ranks).
     type Msg: Clone + Debug + Serialize + DeserializeOwned;
     /// One object's state.
@@ -205,9 +166,13 @@ pub trait Model {
 
 /// A message waiting to be delivered.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct Pending<M> {
+#[serde(bound(
+    serialize = "T: Time, M: Serialize",
+    deserialize = "T: Time, M: DeserializeOwned"
+))]
+pub struct Pending<T, M> {
     /// When it arrives.
-    pub time: VTime,
+    pub time: VTime<T>,
     /// The receiving object.
     pub to: u32,
     /// Its priority in the receiver's batch.
@@ -219,7 +184,7 @@ pub struct Pending<M> {
     pub env: Envelope<M>,
 }
 
-impl<M> Pending<M> {
+impl<T: Time, M> Pending<T, M> {
     /// The delivery order: time, receiver, priority, sender, sequence.
     pub fn order(&self, o: &Self) -> Ordering {
         self.time
@@ -234,7 +199,7 @@ impl<M> Pending<M> {
     /// does (the lead of a pending set's entry, [`queue::Ranked::lead`]).
     #[inline]
     pub fn lead(&self) -> u64 {
-        self.time.key.time_bits()
+        time::time_bits(self.time.t())
     }
 
     /// Integers that order messages of one key as [`Pending::order`] does, then by `uid`:
@@ -269,13 +234,13 @@ pub fn uid(from: u32, n: u64) -> u64 {
 /// What one batch did, handed back to the executor: messages sent, sends retracted, output.
 pub struct Ctx<'a, M: Model + ?Sized> {
     model: &'a M,
-    now: VTime,
+    now: VTime<M::Time>,
     me: u32,
     seq: &'a mut u64,
     /// The object's count of named messages, when the executor names them (Time Warp).
     uids: Option<&'a mut u64>,
     /// Messages sent by this batch.
-    pub sent: Vec<Pending<M::Msg>>,
+    pub sent: Vec<Pending<M::Time, M::Msg>>,
     /// Handles this batch cancelled.
     pub cancelled: Vec<Handle>,
     /// Output this batch produced.
@@ -288,7 +253,7 @@ pub struct Ctx<'a, M: Model + ?Sized> {
 
 impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     /// A context for object `me` at `now`, with its send counter.
-    pub fn new(model: &'a M, now: VTime, me: u32, seq: &'a mut u64) -> Ctx<'a, M> {
+    pub fn new(model: &'a M, now: VTime<M::Time>, me: u32, seq: &'a mut u64) -> Ctx<'a, M> {
         Ctx {
             model,
             now,
@@ -306,7 +271,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     /// A context for a batch that may run on an inconsistent state (Time Warp): a send into
     /// the past is dropped and recorded in `into_past` instead of panicking, for the executor
     /// to report if the batch is ever committed.
-    pub fn speculative(model: &'a M, now: VTime, me: u32, seq: &'a mut u64) -> Ctx<'a, M> {
+    pub fn speculative(model: &'a M, now: VTime<M::Time>, me: u32, seq: &'a mut u64) -> Ctx<'a, M> {
         Ctx {
             speculative: true,
             ..Ctx::new(model, now, me, seq)
@@ -327,7 +292,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     }
 
     /// The virtual time of the batch being handled.
-    pub fn now(&self) -> &VTime {
+    pub fn now(&self) -> &VTime<M::Time> {
         &self.now
     }
 
@@ -337,35 +302,41 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     /// # Panics
     /// If `time` is not after now: a model bug, a message into the past (in a speculative
     /// batch the message is dropped and the batch marked instead).
-    pub fn send_at(&mut self, to: u32, time: VTime, msg: M::Msg) -> Handle {
+    pub fn send_at(&mut self, to: u32, time: VTime<M::Time>, msg: M::Msg) -> Handle {
         self.post(to, time, msg, true)
     }
 
     /// Sends `mine` to this object and then `theirs` to `other`, both at `time`, as
-    /// [`Ctx::send_at`] does; the pair's name cancels them ([`Ctx::cancel_pair`]).
-    pub fn send_pair(&mut self, other: u32, time: VTime, mine: M::Msg, theirs: M::Msg) -> SentPair {
+    /// [`Ctx::send_at`] does; their name cancels them ([`Ctx::cancel_two`]).
+    pub fn send_two(
+        &mut self,
+        other: u32,
+        time: VTime<M::Time>,
+        mine: M::Msg,
+        theirs: M::Msg,
+    ) -> SentTwo {
         let t = time.t();
         let first = self.send_at(self.me, time.clone(), mine);
         let second = self.send_at(other, time, theirs);
-        let pair = SentPair {
+        let two = SentTwo {
             seq: first.seq,
             uid: first.uid,
             t,
         };
         debug_assert!(
-            pair.handles(self.me, other)
+            two.handles(self.me, other)
                 .iter()
                 .zip([first, second])
                 .all(|(a, b)| (a.to, a.seq, a.uid, a.t) == (b.to, b.seq, b.uid, b.t)),
-            "a pair's handles are consecutive"
+            "the two handles are consecutive"
         );
-        pair
+        two
     }
 
     /// Sends `msg` to `to` at `time`, as [`Ctx::send_at`], as a message that is never cancelled
     /// (a relay of news, as the thesis' NewVelocity and VelocityChange: 5.4), so that the
     /// executor need not look it up among the cancellations.
-    pub fn relay_at(&mut self, to: u32, time: VTime, msg: M::Msg) {
+    pub fn relay_at(&mut self, to: u32, time: VTime<M::Time>, msg: M::Msg) {
         self.post(to, time, msg, false);
     }
 
@@ -376,7 +347,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
         self.relay_at(to, time, msg);
     }
 
-    fn post(&mut self, to: u32, time: VTime, msg: M::Msg, retractable: bool) -> Handle {
+    fn post(&mut self, to: u32, time: VTime<M::Time>, msg: M::Msg, retractable: bool) -> Handle {
         *self.seq += 1;
         let mut h = Handle {
             from: self.me,
@@ -421,10 +392,10 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
         self.cancelled.push(h);
     }
 
-    /// Retracts both messages of a pair this object sent with `other` ([`Ctx::send_pair`]), as
+    /// Retracts both messages this object sent to itself and `other` ([`Ctx::send_two`]), as
     /// [`Ctx::cancel`] does.
-    pub fn cancel_pair(&mut self, pair: SentPair, other: u32) {
-        self.cancelled.extend(pair.handles(self.me, other));
+    pub fn cancel_two(&mut self, two: SentTwo, other: u32) {
+        self.cancelled.extend(two.handles(self.me, other));
     }
 
     /// Reports output (a physical event, a drawing).

@@ -4,7 +4,7 @@
 //! Which tier an item is in never changes the order, only the cost.
 
 use super::led_heap::LedHeap;
-use crate::engine::prefetch::prefetch_all;
+use super::prefetch::prefetch_all;
 use dary_heap::QuaternaryHeap;
 
 /// Run items sorted again with fresh ones however few these are (beyond it, only four per fresh

@@ -1,8 +1,10 @@
 //! The sequential executor: one pending set ([`Queue`]), batches run strictly in order.
 
+use super::prefetch::{prefetch, prefetch_all};
 use super::queue::{Queue, Ranked};
-use super::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
-use crate::engine::prefetch::{prefetch, prefetch_all};
+use super::{
+    Ctx, Envelope, Handle, MessageStats, Model, Pending, Time, VTime, RESERVED_PER_OBJECT,
+};
 use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
 
@@ -11,29 +13,29 @@ pub type Sink<'a, M, E> =
     dyn FnMut(&M, &[<M as Model>::State], <M as Model>::Output) -> Result<(), E> + 'a;
 
 /// A pending message ordered for a min-heap.
-struct Item<M>(Pending<M>);
+struct Item<T, M>(Pending<T, M>);
 
-impl<M> PartialEq for Item<M> {
+impl<T: Time, M> PartialEq for Item<T, M> {
     fn eq(&self, o: &Self) -> bool {
         self.0.order(&o.0) == Ordering::Equal
     }
 }
 
-impl<M> Eq for Item<M> {}
+impl<T: Time, M> Eq for Item<T, M> {}
 
-impl<M> PartialOrd for Item<M> {
+impl<T: Time, M> PartialOrd for Item<T, M> {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
         Some(self.cmp(o))
     }
 }
 
-impl<M> Ord for Item<M> {
+impl<T: Time, M> Ord for Item<T, M> {
     fn cmp(&self, o: &Self) -> Ordering {
         o.0.order(&self.0)
     }
 }
 
-impl<M> Ranked for Item<M> {
+impl<T: Time, M> Ranked for Item<T, M> {
     fn rank(&self) -> [u64; 4] {
         self.0.rank(0).map(|x| !x)
     }
@@ -50,20 +52,20 @@ pub struct Sequential<M: Model> {
     model: M,
     states: Vec<M::State>,
     seqs: Vec<u64>,
-    pending: Queue<Item<M::Msg>>,
+    pending: Queue<Item<M::Time, M::Msg>>,
     cancelled: FxHashSet<Handle>,
     stats: MessageStats,
-    now: Option<VTime>,
+    now: Option<VTime<M::Time>>,
     /// Buffers kept from batch to batch: the batch, and what it sent and cancelled.
     batch: Vec<Envelope<M::Msg>>,
-    sent: Vec<Pending<M::Msg>>,
+    sent: Vec<Pending<M::Time, M::Msg>>,
     retracted: Vec<Handle>,
 }
 
 impl<M: Model> Sequential<M> {
     /// Sets up the model's objects with their initial states and runs every object's `init` at
     /// virtual time `start` (in object order).
-    pub fn new(model: M, states: Vec<M::State>, start: VTime) -> Sequential<M> {
+    pub fn new(model: M, states: Vec<M::State>, start: VTime<M::Time>) -> Sequential<M> {
         let reserved = RESERVED_PER_OBJECT * states.len();
         let mut s = Sequential {
             seqs: vec![0; states.len()],
@@ -106,7 +108,7 @@ impl<M: Model> Sequential<M> {
     }
 
     /// The virtual time of the last batch run.
-    pub fn now(&self) -> Option<&VTime> {
+    pub fn now(&self) -> Option<&VTime<M::Time>> {
         self.now.as_ref()
     }
 
@@ -116,7 +118,7 @@ impl<M: Model> Sequential<M> {
     }
 
     /// Pops the next message that was not cancelled.
-    fn pop_live(&mut self) -> Option<Pending<M::Msg>> {
+    fn pop_live(&mut self) -> Option<Pending<M::Time, M::Msg>> {
         while let Some(Item(p)) = self.pending.pop() {
             if !(p.retractable && self.cancelled.remove(&p.handle())) {
                 return Some(p);
@@ -205,13 +207,14 @@ impl<M: Model> Sequential<M> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vtime::Key;
+    use crate::kernel::PlainTime;
 
     /// One object that, every unit of time, schedules a far-future reminder and cancels the
     /// previous one: a pending set that kept cancelled messages would grow with every step.
     struct Forgetful;
 
     impl Model for Forgetful {
+        type Time = PlainTime;
         type Msg = bool;
         type State = Option<Handle>;
         type Output = ();
@@ -226,7 +229,7 @@ mod tests {
             0
         }
         fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, _: &mut Option<Handle>) {
-            ctx.send_at(me, VTime::at(Key::start(1.0)), true);
+            ctx.send_at(me, VTime::start(1.0), true);
         }
         fn handle(
             &self,
@@ -239,14 +242,14 @@ mod tests {
             if let Some(h) = reminder.take() {
                 ctx.cancel(h);
             }
-            *reminder = Some(ctx.send_at(me, VTime::at(Key::start(t + 1e6)), false));
-            ctx.send_at(me, VTime::at(Key::start(t + 1.0)), true);
+            *reminder = Some(ctx.send_at(me, VTime::start(t + 1e6), false));
+            ctx.send_at(me, VTime::start(t + 1.0), true);
         }
     }
 
     #[test]
     fn cancelled_messages_do_not_pile_up() {
-        let mut s = Sequential::new(Forgetful, vec![None], VTime::at(Key::start(0.0)));
+        let mut s = Sequential::new(Forgetful, vec![None], VTime::start(0.0));
         s.run(20_000.0, &mut |_, _, ()| Ok::<(), ()>(())).unwrap();
         assert_eq!(s.stats().batches, 20_000);
         assert_eq!(s.stats().cancels, 19_999);

@@ -14,9 +14,8 @@
 use crate::kernel::sequential::Sequential;
 use crate::kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
 use crate::kernel::time_warp::{TwConfig, TwStats};
-use crate::kernel::{Ctx, Envelope, Model, VTime};
+use crate::kernel::{Ctx, Envelope, Model, PlainTime, VTime};
 use crate::output::fnv_hex;
-use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::convert::Infallible;
@@ -105,14 +104,13 @@ impl Phold {
     fn send(&self, ctx: &mut Ctx<'_, Phold>, me: u32, state: &mut PholdState) {
         let (to, delay) = self.draw(me, &mut state.rng);
         state.sends += 1;
-        // ties between messages at one time are broken by sender and the sender's count
-        let tie = (u64::from(me) << 32) | (state.sends & 0xffff_ffff);
         let t = ctx.now().t() + delay;
-        ctx.send_at(to, VTime::at(Key::at(t, tie)), ());
+        ctx.send_at(to, VTime::at(PlainTime(t)), ());
     }
 }
 
 impl Model for Phold {
+    type Time = PlainTime;
     type Msg = ();
     type State = PholdState;
     type Output = ();
@@ -202,7 +200,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
         cfg.partitions,
     );
     let (model, states) = Phold::new(cfg);
-    let t0 = VTime::at(Key::start(0.0));
+    let t0 = VTime::start(0.0);
     let never = |_: &Phold, _: &[PholdState], _: ()| -> Result<(), Infallible> { Ok(()) };
     let (stats, finals, time_warp) = match tw {
         None => {
@@ -272,7 +270,7 @@ mod tests {
 
     fn run(c: PholdConfig, end: f64) -> (u64, Vec<u64>, usize) {
         let (model, states) = Phold::new(c);
-        let mut ex = Sequential::new(model, states, VTime::at(Key::start(0.0)));
+        let mut ex = Sequential::new(model, states, VTime::start(0.0));
         ex.run::<()>(end, &mut |_, _, _| Ok(())).unwrap();
         let handled: Vec<u64> = ex.states().iter().map(|s| s.handled).collect();
         (ex.stats().delivered, handled, ex.pending_len())
@@ -333,7 +331,7 @@ mod time_warp_tests {
             for chaos in [None, Some(7)] {
                 let c = cfg(workers as u32);
                 let (model, states) = Phold::new(c.clone());
-                let mut seq = Sequential::new(model, states, VTime::at(Key::start(0.0)));
+                let mut seq = Sequential::new(model, states, VTime::start(0.0));
                 seq.run::<()>(30.0, &mut |_, _, _| Ok(())).unwrap();
                 let (model, states) = Phold::new(c);
                 let worker_of: Vec<u32> = (0..96).map(|o| model.partition(o)).collect();
@@ -343,13 +341,7 @@ mod time_warp_tests {
                     gvt_interval: Some(64),
                     ..Default::default()
                 };
-                let mut tw = TimeWarp::new(
-                    model,
-                    states,
-                    VTime::at(Key::start(0.0)),
-                    &worker_of,
-                    tw_cfg,
-                );
+                let mut tw = TimeWarp::new(model, states, VTime::start(0.0), &worker_of, tw_cfg);
                 tw.run::<()>(30.0, &mut |_, _, _| Ok(())).unwrap();
                 let a: Vec<(u64, u64)> =
                     seq.states().iter().map(|s| (s.handled, s.sends)).collect();

@@ -34,7 +34,7 @@
 
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::Trajectory;
-use crate::kernel::{Ctx, Envelope, Model, SentPair, VTime};
+use crate::kernel::{Ctx, Envelope, Model, SentTwo, VTime};
 use crate::physics::{self, Contact};
 use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, DISPLAY, REVERSAL};
@@ -86,7 +86,7 @@ impl BallInfo {
     /// Turns ball `me` around at `now` (thesis 4.6, fig. 13). On the table it takes a position fix
     /// and reverses: `None`, its trajectory changed now. In a pocket it reverses the crossing it
     /// dropped in by and returns the key at which it comes back out (the mirror image in time).
-    pub fn reverse(&mut self, me: u32, now: &VTime, table: &Table) -> Option<Key> {
+    pub fn reverse(&mut self, me: u32, now: &VTime<Key>, table: &Table) -> Option<Key> {
         let back = match self.pocket {
             None => {
                 self.traj.position = self.traj.at(now.t());
@@ -107,7 +107,7 @@ impl BallInfo {
 
     /// Ball `me` comes back out of its pocket at `now`: the event to report (a mirrored pocket
     /// crossing).
-    pub fn come_back(&mut self, me: u32, now: &VTime, table: &Table) -> Event {
+    pub fn come_back(&mut self, me: u32, now: &VTime<Key>, table: &Table) -> Event {
         let k = self.pocket.take().expect("only a pocketed ball returns");
         self.fix(&now.key);
         Event {
@@ -173,13 +173,13 @@ pub struct Planned {
     /// The other object of the collision (the one that is not the scheduler).
     pub partner: u32,
     /// The Collision messages to the scheduler itself and to the partner.
-    pub sent: SentPair,
+    pub sent: SentTwo,
 }
 
 impl Planned {
     /// Retracts both Collision messages (two thesis Cancel messages).
     pub fn cancel<M: Model + ?Sized>(self, ctx: &mut Ctx<'_, M>) {
-        ctx.cancel_pair(self.sent, self.partner);
+        ctx.cancel_two(self.sent, self.partner);
     }
 }
 
@@ -311,7 +311,7 @@ impl Pool {
     }
 
     /// The virtual time at which a NewVelocity sent now to `to` arrives.
-    fn nv_time(&self, ctx: &Ctx<'_, Pool>, me: u32, to: u32) -> VTime {
+    fn nv_time(&self, ctx: &Ctx<'_, Pool>, me: u32, to: u32) -> VTime<Key> {
         match self.delay {
             NvDelay::Exact => ctx.now().next_gen(),
             NvDelay::Delay(d) => VTime::at(Key::at(ctx.now().t() + d, pair(me, to))),
@@ -336,7 +336,7 @@ impl Pool {
     /// becomes immediate if the objects still overlap and close (5.3).
     fn contact_key(
         &self,
-        now: &VTime,
+        now: &VTime<Key>,
         contact: Contact,
         parent: &Key,
         p: crate::vtime::Pair,
@@ -361,7 +361,7 @@ impl Pool {
         theirs: Option<Arc<BallInfo>>,
     ) -> Planned {
         debug_assert_eq!(me, ctx.me(), "an object schedules its own collisions");
-        let sent = ctx.send_pair(
+        let sent = ctx.send_two(
             partner,
             VTime::at(key),
             PoolMsg::Collision {
@@ -593,6 +593,7 @@ fn overlapping_and_closing(a: &BallInfo, b: &BallInfo, t: f64) -> bool {
 }
 
 impl Model for Pool {
+    type Time = Key;
     type Msg = PoolMsg;
     type State = PoolState;
     type Output = PoolOutput;

@@ -33,7 +33,7 @@
 use super::pool::{cancel_with, BallInfo, Planned, Plans};
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::{Trajectory, Vec2};
-use crate::kernel::{Ctx, Envelope, Model, SentPair, VTime};
+use crate::kernel::{Ctx, Envelope, Model, SentTwo, VTime};
 use crate::physics::{self, Contact};
 use crate::polygon::{self, Polygon};
 use crate::scenario::{BallSpec, Scenario};
@@ -332,7 +332,7 @@ pub struct Passage {
     /// may undo).
     entry: u64,
     /// The messages to the sector itself and to the ball.
-    pub sent: SentPair,
+    pub sent: SentTwo,
 }
 
 /// [`Passage`]'s `entry` of a departure: no trajectory has this version (one ball would
@@ -596,7 +596,7 @@ impl Sectored {
         their_version: u64,
     ) -> Planned {
         debug_assert_eq!(me, ctx.me(), "an object schedules its own collisions");
-        let sent = ctx.send_pair(
+        let sent = ctx.send_two(
             partner,
             VTime::at(key),
             SecMsg::Collision {
@@ -885,7 +885,7 @@ impl Sectored {
         me: u32,
         ball: u32,
         entry: Option<Arc<BallInfo>>,
-        time: VTime,
+        time: VTime<Key>,
     ) -> Passage {
         debug_assert_eq!(me, ctx.me(), "a sector schedules its own passages");
         let version = entry.as_ref().map_or(DEPARTS, |e| e.version);
@@ -896,11 +896,11 @@ impl Sectored {
                     sector: me,
                     info,
                 };
-                ctx.send_pair(ball, time, entering(Some(info)), entering(None))
+                ctx.send_two(ball, time, entering(Some(info)), entering(None))
             }
             None => {
                 let msg = SecMsg::SectorDeparture { ball, sector: me };
-                ctx.send_pair(ball, time, msg.clone(), msg)
+                ctx.send_two(ball, time, msg.clone(), msg)
             }
         };
         Passage {
@@ -914,7 +914,7 @@ impl Sectored {
     fn cancel_passage(ctx: &mut Ctx<'_, Sectored>, planned: &mut Vec<Passage>, ball: u32) {
         if let Some(k) = planned.iter().position(|p| p.ball == ball) {
             let p = planned.swap_remove(k);
-            ctx.cancel_pair(p.sent, p.ball);
+            ctx.cancel_two(p.sent, p.ball);
         }
     }
 
@@ -1064,6 +1064,7 @@ impl Sectored {
 }
 
 impl Model for Sectored {
+    type Time = Key;
     type Msg = SecMsg;
     type State = SecState;
     type Output = Event;

@@ -9,14 +9,14 @@
 //! batch before the floor can change any more, whatever its time.
 //!
 //! It has a fixed size so that reductions carry it as plain words (threads, and MPI as seven
-//! 64-bit integers): a key deeper than [`DEPTH`] pairs is cut to its first pairs, which sorts
-//! before the whole key, so the cut only makes GVT more cautious.
+//! 64-bit integers): a time whose tie-break is longer than [`DEPTH`] words is cut to its first
+//! words, which sorts before the whole time, so the cut only makes GVT more cautious.
 
-use super::super::VTime;
+use super::super::time::{Time, VTime, TIE_WORDS};
 use std::cmp::Ordering;
 
-/// The pairs of a key's path a floor keeps.
-pub const DEPTH: usize = 4;
+/// The words of a time's tie-break ([`Time::tie_words`]) a floor keeps.
+pub const DEPTH: usize = TIE_WORDS;
 
 /// A lower bound on the (virtual time, receiver) of every batch that may still change.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,15 +46,15 @@ impl Floor {
         }
     }
 
-    /// The place of the batch of object `to` at `time`, or just before it when its key is
-    /// deeper than [`DEPTH`].
-    pub fn of(time: &VTime, to: u32) -> Floor {
-        let path = time.key.path.as_slice();
-        let mut f = Floor::start(time.key.t);
-        let kept = path.len().min(DEPTH);
-        f.path[..kept].copy_from_slice(&path[..kept]);
+    /// The place of the batch of object `to` at `time`, or just before it when its time's
+    /// tie-break is longer than [`DEPTH`] words.
+    pub fn of<T: Time>(time: &VTime<T>, to: u32) -> Floor {
+        let mut f = Floor::start(time.t());
+        let n = time.key.tie_words(&mut f.path);
+        let kept = n.min(DEPTH);
+        f.path[kept..].fill(0);
         f.len = kept as u8;
-        if kept == path.len() {
+        if kept == n {
             f.gen = time.gen;
             f.to = to;
         }
@@ -62,24 +62,44 @@ impl Floor {
     }
 
     /// Whether the batch of object `to` at `time` comes before this floor (and is final).
-    pub fn passed(&self, time: &VTime, to: u32) -> bool {
-        self.cmp_with(time.key.t, &time.key.path, time.gen, to)
-            .is_gt()
+    #[inline]
+    pub fn passed<T: Time>(&self, time: &VTime<T>, to: u32) -> bool {
+        self.cmp_with(time, to).is_gt()
     }
 
     /// Whether the batch of object `to` at `time` comes at or before this floor.
-    pub fn reaches(&self, time: &VTime, to: u32) -> bool {
-        self.cmp_with(time.key.t, &time.key.path, time.gen, to)
-            .is_ge()
+    #[inline]
+    pub fn reaches<T: Time>(&self, time: &VTime<T>, to: u32) -> bool {
+        self.cmp_with(time, to).is_ge()
     }
 
-    /// How this floor compares with the place (time `t`, key path, generation, receiver).
-    fn cmp_with(&self, t: f64, path: &[u64], gen: u32, to: u32) -> Ordering {
+    /// How this floor compares with the place of the batch of object `to` at `time`.
+    fn cmp_with<T: Time>(&self, time: &VTime<T>, to: u32) -> Ordering {
+        self.t.total_cmp(&time.t()).then_with(|| {
+            let mut words = [0u64; DEPTH];
+            let n = time.key.tie_words(&mut words);
+            let kept = n.min(DEPTH);
+            // a time cut to its first words sorts after a floor of those words alone
+            let cut = if n > DEPTH {
+                Ordering::Less
+            } else {
+                Ordering::Equal
+            };
+            self.path[..usize::from(self.len)]
+                .cmp(&words[..kept])
+                .then(cut)
+                .then(self.gen.cmp(&time.gen))
+                .then(self.to.cmp(&to))
+        })
+    }
+
+    /// How this floor compares with another.
+    fn cmp_floor(&self, o: &Floor) -> Ordering {
         self.t
-            .total_cmp(&t)
-            .then_with(|| self.path[..usize::from(self.len)].cmp(path))
-            .then(self.gen.cmp(&gen))
-            .then(self.to.cmp(&to))
+            .total_cmp(&o.t)
+            .then_with(|| self.path[..usize::from(self.len)].cmp(&o.path[..usize::from(o.len)]))
+            .then(self.gen.cmp(&o.gen))
+            .then(self.to.cmp(&o.to))
     }
 
     /// Below every message a worker standing at this floor may still send: a send is later
@@ -131,22 +151,66 @@ impl Floor {
 
 impl PartialOrd for Floor {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp_with(o.t, &o.path[..usize::from(o.len)], o.gen, o.to))
+        Some(self.cmp_floor(o))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vtime::{pair, Key};
     use proptest::prelude::*;
-    use smallvec::SmallVec;
 
-    fn vtime(t: f64, path: &[u64], gen: u32) -> VTime {
+    /// A time with a tie-break of any length: a simulation time and words compared in turn.
+    #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+    struct PathTime {
+        t: f64,
+        path: Vec<u64>,
+    }
+
+    impl PartialEq for PathTime {
+        fn eq(&self, o: &Self) -> bool {
+            self.cmp(o).is_eq()
+        }
+    }
+
+    impl Eq for PathTime {}
+
+    impl PartialOrd for PathTime {
+        fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+            Some(self.cmp(o))
+        }
+    }
+
+    impl Ord for PathTime {
+        fn cmp(&self, o: &Self) -> Ordering {
+            self.t.total_cmp(&o.t).then_with(|| self.path.cmp(&o.path))
+        }
+    }
+
+    impl Time for PathTime {
+        fn start(t: f64) -> Self {
+            PathTime { t, path: vec![] }
+        }
+        fn t(&self) -> f64 {
+            self.t
+        }
+        fn tie_words(&self, out: &mut [u64; TIE_WORDS]) -> usize {
+            let kept = self.path.len().min(TIE_WORDS);
+            out[..kept].copy_from_slice(&self.path[..kept]);
+            self.path.len()
+        }
+    }
+
+    /// Stands for an event between objects `a` and `b`.
+    fn pair(a: u32, b: u32) -> u64 {
+        u64::from(a) << 32 | u64::from(b)
+    }
+
+    fn vtime(t: f64, path: &[u64], gen: u32) -> VTime<PathTime> {
         VTime {
-            key: Key {
+            key: PathTime {
                 t,
-                path: SmallVec::from_slice(path),
+                path: path.to_vec(),
             },
             gen,
         }
@@ -194,7 +258,7 @@ mod tests {
         assert_eq!(Floor::INFINITY.next_generation(), Floor::INFINITY);
     }
 
-    fn arb_vtime() -> impl Strategy<Value = VTime> {
+    fn arb_vtime() -> impl Strategy<Value = VTime<PathTime>> {
         (-2i32..3, prop::collection::vec(0u64..4, 0..7), 0u32..3)
             .prop_map(|(t, path, gen)| vtime(f64::from(t), &path, gen))
     }

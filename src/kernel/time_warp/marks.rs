@@ -4,7 +4,7 @@
 //! worker reads when the message reaches the top of its heap, as the sequential executor reads
 //! its set of cancelled handles: most messages are never marked, and cost no lookup by name.
 
-use super::super::Pending;
+use super::super::{Pending, Time};
 use rustc_hash::{FxHashMap, FxHashSet};
 use smallvec::SmallVec;
 
@@ -35,7 +35,7 @@ pub enum Mark {
 }
 
 /// The marks of one worker's messages.
-pub struct Marks<Msg> {
+pub struct Marks<T, Msg> {
     /// Anti-messages whose message has not been dropped yet (it is in the heap or on its way).
     annulled: FxHashSet<u64>,
     /// Retractions (cancellations by batches run as final) likewise: kept apart because they
@@ -44,13 +44,13 @@ pub struct Marks<Msg> {
     /// Model cancellations, by the uid of the cancelled message.
     cancels: FxHashMap<u64, Cancels>,
     /// Cancelled messages taken off the heap, by uid: undoing the cancellation brings them back.
-    dead: FxHashMap<u64, Pending<Msg>>,
+    dead: FxHashMap<u64, Pending<T, Msg>>,
     /// Size of `cancels` and `dead` past which fossil collection sweeps them (amortized: twice
     /// what is left after each sweep).
     sweep_at: usize,
 }
 
-impl<Msg> Default for Marks<Msg> {
+impl<T: Time, Msg> Default for Marks<T, Msg> {
     fn default() -> Self {
         Marks {
             annulled: FxHashSet::default(),
@@ -62,7 +62,7 @@ impl<Msg> Default for Marks<Msg> {
     }
 }
 
-impl<Msg> Marks<Msg> {
+impl<T: Time, Msg> Marks<T, Msg> {
     /// How message `uid` stands (`retractable`: whether its sender may cancel it).
     #[inline]
     pub fn of(&self, uid: u64, retractable: bool) -> Mark {
@@ -88,7 +88,7 @@ impl<Msg> Marks<Msg> {
     /// Takes a message that is not live off the heap's hands: an annulled one is dropped (its
     /// anti-message is spent), a cancelled one set aside, or dropped too if a batch before
     /// `gvt` cancelled it (committed: for good).
-    pub fn set_aside(&mut self, uid: u64, p: Pending<Msg>, mark: Mark, gvt: f64) {
+    pub fn set_aside(&mut self, uid: u64, p: Pending<T, Msg>, mark: Mark, gvt: f64) {
         match mark {
             Mark::Annulled => self.unmark(uid),
             Mark::Cancelled => {
@@ -141,7 +141,13 @@ impl<Msg> Marks<Msg> {
     /// (`sign` 1) or its undoing (-1). Returns whether the message's standing changed
     /// (cancelled or not), and the message if the cancellation no longer stands and the
     /// message was set aside.
-    pub fn cancel(&mut self, uid: u64, t: f64, at: f64, sign: i8) -> (bool, Option<Pending<Msg>>) {
+    pub fn cancel(
+        &mut self,
+        uid: u64,
+        t: f64,
+        at: f64,
+        sign: i8,
+    ) -> (bool, Option<Pending<T, Msg>>) {
         use std::collections::hash_map::Entry;
         let c = match self.cancels.entry(uid) {
             Entry::Occupied(e) => e.into_mut(),
@@ -245,12 +251,12 @@ impl<Msg> Marks<Msg> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::PlainTime;
     use crate::kernel::{Envelope, VTime};
-    use crate::vtime::Key;
 
-    fn msg(t: f64) -> Pending<u8> {
+    fn msg(t: f64) -> Pending<PlainTime, u8> {
         Pending {
-            time: VTime::at(Key::start(t)),
+            time: VTime::start(t),
             to: 0,
             priority: 0,
             retractable: true,
@@ -264,7 +270,7 @@ mod tests {
 
     #[test]
     fn an_anti_message_meets_its_message_in_either_order() {
-        let mut m: Marks<u8> = Marks::default();
+        let mut m: Marks<PlainTime, u8> = Marks::default();
         assert_eq!(m.of(7, true), Mark::Live);
         // the anti-message first: the message is dropped as it arrives
         assert!(!m.annul(7));
@@ -280,7 +286,7 @@ mod tests {
 
     #[test]
     fn a_retraction_names_only_a_message_its_sender_may_cancel() {
-        let mut m: Marks<u8> = Marks::default();
+        let mut m: Marks<PlainTime, u8> = Marks::default();
         assert!(!m.retract(5));
         assert_eq!(m.of(5, true), Mark::Annulled);
         // a relay is never retracted, so its lookups skip the retractions
@@ -302,7 +308,7 @@ mod tests {
 
     #[test]
     fn a_cancellation_undone_brings_its_message_back() {
-        let mut m: Marks<u8> = Marks::default();
+        let mut m: Marks<PlainTime, u8> = Marks::default();
         assert!(matches!(m.cancel(3, 2.0, 1.0, 1), (true, None)));
         assert_eq!(m.of(3, true), Mark::Cancelled);
         assert_eq!(m.of(3, false), Mark::Live, "a relay is never cancelled");
@@ -324,7 +330,7 @@ mod tests {
 
     #[test]
     fn a_committed_cancellation_is_a_retraction() {
-        let mut m: Marks<u8> = Marks::default();
+        let mut m: Marks<PlainTime, u8> = Marks::default();
         // in the heap: the cancellation's entry goes, and the message is dropped at the top
         m.cancel(3, 2.0, 1.0, 1);
         m.promote(3, 1.0);
@@ -347,7 +353,7 @@ mod tests {
 
     #[test]
     fn fossil_collection_frees_what_nothing_can_revive() {
-        let mut m: Marks<u8> = Marks {
+        let mut m: Marks<PlainTime, u8> = Marks {
             sweep_at: 0,
             ..Marks::default()
         };

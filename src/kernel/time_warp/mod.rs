@@ -67,21 +67,19 @@ pub use floor::Floor;
 use log::{Chain, Log};
 use marks::{Mark, Marks};
 
+use super::prefetch::{prefetch, prefetch_all};
 use super::queue::{Queue, Ranked};
 use super::{
-    uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT,
+    uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, Time, VTime, RESERVED_PER_OBJECT,
     STATE_CLASSES,
 };
-use crate::engine::prefetch::{prefetch, prefetch_all};
-use crate::vtime::Key;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::cmp::Ordering;
 
-/// The deepest key (cascade of immediate events at one instant) Time Warp runs: its GVT does not
-/// tell keys apart past a few steps, so an instant this deep cannot commit, and one that never
-/// ends would fill memory (each step copies the key into every message it sends). The sequential
-/// engines stop a ball's instant at 1,000 events too.
+/// The deepest time ([`Time::depth`]: a cascade of zero-delay steps at one instant) Time Warp
+/// runs: its GVT does not tell times apart past a few words of their tie-break, so an instant
+/// this deep cannot commit, and one that never ends would fill memory.
 pub const MAX_CASCADE_DEPTH: usize = 1_000;
 
 /// Batches between GVT rounds in one process, unless set.
@@ -222,13 +220,17 @@ impl TwStats {
 
 /// One unit of transport between workers.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub enum Op<Msg> {
+#[serde(bound(
+    serialize = "T: Time, Msg: serde::Serialize",
+    deserialize = "T: Time, Msg: serde::de::DeserializeOwned"
+))]
+pub enum Op<T, Msg> {
     /// A message.
     Msg {
         /// Its transport name.
         uid: u64,
         /// The message.
-        p: Pending<Msg>,
+        p: Pending<T, Msg>,
     },
     /// The anti-message of `uid`.
     Anti {
@@ -237,7 +239,7 @@ pub enum Op<Msg> {
         /// Its receiver.
         to: u32,
         /// Its time.
-        time: VTime,
+        time: VTime<T>,
     },
     /// A model cancellation (`sign` 1) or the undoing of one (`sign` -1), by the batch of
     /// object `by` at `at`. It can change only batches after that one, which is all the place
@@ -246,7 +248,7 @@ pub enum Op<Msg> {
         /// The cancelled message.
         h: Handle,
         /// The time of the cancelling batch.
-        at: VTime,
+        at: VTime<T>,
         /// The cancelling object.
         by: u32,
         /// 1 to cancel, -1 to undo.
@@ -258,13 +260,16 @@ pub enum Op<Msg> {
         /// The cancelled message.
         h: Handle,
         /// The time of the cancelling batch.
-        at: VTime,
+        at: VTime<T>,
         /// The cancelling object.
         by: u32,
     },
 }
 
-impl<Msg> Op<Msg> {
+/// The ops of model `M`.
+pub type OpOf<M> = Op<<M as Model>::Time, <M as Model>::Msg>;
+
+impl<T: Time, Msg> Op<T, Msg> {
     /// The receiving object.
     pub fn to(&self) -> u32 {
         match self {
@@ -276,7 +281,7 @@ impl<Msg> Op<Msg> {
 
     /// The first batch the op may change, as a virtual time and an object: the message's own
     /// place, or the place just after the batch that cancelled it.
-    pub fn place(&self) -> (&VTime, u32) {
+    pub fn place(&self) -> (&VTime<T>, u32) {
         match self {
             Op::Msg { p, .. } => (&p.time, p.to),
             Op::Anti { time, to, .. } => (time, *to),
@@ -291,7 +296,7 @@ impl<Msg> Op<Msg> {
     }
 
     /// The smallest floor of `ops` ([`Floor::INFINITY`] for none).
-    pub fn lowest(ops: &[Op<Msg>]) -> Floor {
+    pub fn lowest(ops: &[Op<T, Msg>]) -> Floor {
         ops.iter().map(Op::floor).fold(Floor::INFINITY, Floor::min)
     }
 }
@@ -325,9 +330,13 @@ impl Reduction {
 
 /// One committed batch as the collector needs it.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct Committed<S, O> {
+#[serde(bound(
+    serialize = "T: Time, S: serde::Serialize, O: serde::Serialize",
+    deserialize = "T: Time, S: serde::de::DeserializeOwned, O: serde::de::DeserializeOwned"
+))]
+pub struct Committed<T, S, O> {
     /// Its virtual time.
-    pub time: VTime,
+    pub time: VTime<T>,
     /// The object that ran it.
     pub obj: u32,
     /// The object's state after it, if the model's sinks observe the object.
@@ -336,15 +345,22 @@ pub struct Committed<S, O> {
     pub output: Vec<O>,
 }
 
+/// A committed batch of model `M`.
+pub type CommittedOf<M> = Committed<<M as Model>::Time, <M as Model>::State, <M as Model>::Output>;
+
 /// What a worker hands the collector after a GVT round.
 #[derive(Debug, serde::Serialize, serde::Deserialize)]
-pub struct Chunk<S, O> {
+#[serde(bound(
+    serialize = "T: Time, S: serde::Serialize, O: serde::Serialize",
+    deserialize = "T: Time, S: serde::de::DeserializeOwned, O: serde::de::DeserializeOwned"
+))]
+pub struct Chunk<T, S, O> {
     /// The worker.
     pub worker: usize,
     /// The round.
     pub round: u64,
     /// Batches committed in this round that carry output or observed states, in any order.
-    pub batches: Vec<Committed<S, O>>,
+    pub batches: Vec<Committed<T, S, O>>,
     /// Set on the worker's last chunk of a run: its statistics.
     pub last: Option<(TwStats, MessageStats, u64)>,
     /// On the last chunk of a run that ended well, from a worker whose collector runs in
@@ -388,13 +404,13 @@ impl Bounds {
 /// How workers reach each other: delivery of ops, reductions and the collector.
 pub trait Fabric<M: Model>: Sync {
     /// Sends ops to worker `to`.
-    fn send(&self, from: usize, to: usize, ops: Vec<Op<M::Msg>>);
+    fn send(&self, from: usize, to: usize, ops: Vec<Op<M::Time, M::Msg>>);
     /// Appends every op that has arrived for worker `me`.
-    fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>);
+    fn recv(&self, me: usize, into: &mut Vec<Op<M::Time, M::Msg>>);
     /// Reduces `local` over every worker; all workers call it the same number of times.
     fn reduce(&self, me: usize, local: Reduction) -> Reduction;
     /// Hands a chunk of committed batches to the collector.
-    fn commit(&self, chunk: Chunk<M::State, M::Output>);
+    fn commit(&self, chunk: Chunk<M::Time, M::State, M::Output>);
     /// Whether workers publish floors here and [`Fabric::peers_floor`] can answer: without,
     /// no batch runs as final.
     fn shares_floors(&self) -> bool {
@@ -424,12 +440,12 @@ pub trait Fabric<M: Model>: Sync {
 }
 
 /// A message waiting in a worker's heap, with its transport name.
-struct Item<Msg> {
+struct Item<T, Msg> {
     uid: u64,
-    p: Pending<Msg>,
+    p: Pending<T, Msg>,
 }
 
-impl<Msg> Item<Msg> {
+impl<T: Time, Msg> Item<T, Msg> {
     /// The delivery order; two sends of one message (the second after a rollback) by uid.
     fn order(&self, o: &Self) -> Ordering {
         self.p.order(&o.p).then(self.uid.cmp(&o.uid))
@@ -448,7 +464,7 @@ impl<Msg> Item<Msg> {
 
 impl Input {
     /// The message again, as it waited for the batch of `to` at `time` (undone by a rollback).
-    fn into_item<Msg>(self, env: Envelope<Msg>, time: &VTime, to: u32) -> Item<Msg> {
+    fn into_item<T: Time, Msg>(self, env: Envelope<Msg>, time: &VTime<T>, to: u32) -> Item<T, Msg> {
         let p = Pending {
             time: time.clone(),
             to,
@@ -460,27 +476,27 @@ impl Input {
     }
 }
 
-impl<Msg> PartialEq for Item<Msg> {
+impl<T: Time, Msg> PartialEq for Item<T, Msg> {
     fn eq(&self, o: &Self) -> bool {
         self.order(o) == Ordering::Equal
     }
 }
 
-impl<Msg> Eq for Item<Msg> {}
+impl<T: Time, Msg> Eq for Item<T, Msg> {}
 
-impl<Msg> PartialOrd for Item<Msg> {
+impl<T: Time, Msg> PartialOrd for Item<T, Msg> {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
         Some(self.cmp(o))
     }
 }
 
-impl<Msg> Ord for Item<Msg> {
+impl<T: Time, Msg> Ord for Item<T, Msg> {
     fn cmp(&self, o: &Self) -> Ordering {
         o.order(self)
     }
 }
 
-impl<Msg> Ranked for Item<Msg> {
+impl<T: Time, Msg> Ranked for Item<T, Msg> {
     fn rank(&self) -> [u64; 4] {
         // the heap's order is the delivery order reversed
         self.p.rank(self.uid).map(|x| !x)
@@ -495,10 +511,10 @@ impl<Msg> Ranked for Item<Msg> {
 
 /// A message an uncommitted batch sent, as its sender remembers it to annul it.
 #[derive(Clone, Debug)]
-struct Sent {
+struct Sent<T> {
     uid: u64,
     to: u32,
-    time: VTime,
+    time: VTime<T>,
 }
 
 /// What a batch keeps of each message it handled, besides the envelope, to put it back.
@@ -510,20 +526,20 @@ struct Input {
 
 /// Vectors of finished batches, kept for the next ones: a worker runs millions of batches, and
 /// each would otherwise allocate and free the same few small vectors.
-struct Spare<Msg, State> {
+struct Spare<T, Msg, State> {
     /// Saved states freed by commits and rollbacks, by [`Model::state_class`]: a batch's state
     /// is saved into one of its kind with `clone_from`, which reuses the buffers the state
     /// holds instead of allocating.
     states: [Vec<State>; STATE_CLASSES],
     inputs: Vec<Vec<Input>>,
     batches: Vec<Vec<Envelope<Msg>>>,
-    sent: Vec<Vec<(Sent, u16)>>,
+    sent: Vec<Vec<(Sent<T>, u16)>>,
     cancels: Vec<Vec<Handle>>,
     /// What the model's handler sends, emptied after every batch.
-    pending: Vec<Pending<Msg>>,
+    pending: Vec<Pending<T, Msg>>,
     /// Cancellations and retractions a batch makes, emptied after every batch (its messages go
     /// out as it files them).
-    ops: Vec<Op<Msg>>,
+    ops: Vec<Op<T, Msg>>,
 }
 
 /// Vectors of each kind kept at most.
@@ -532,7 +548,7 @@ const SPARE: usize = 64;
 /// runs ahead (two GVT intervals on threads), so that a worker saves states without allocating.
 const SPARE_STATES: usize = 4096;
 
-impl<Msg, State> Default for Spare<Msg, State> {
+impl<T: Time, Msg, State> Default for Spare<T, Msg, State> {
     fn default() -> Self {
         Spare {
             states: Default::default(),
@@ -633,7 +649,7 @@ fn take<T>(pool: &mut Vec<Vec<T>>) -> Vec<T> {
 /// Whether the message of `h` is still to come after the batch at `time` that cancels it:
 /// sent (not dropped as a send into the past) and not before that batch's instant. A model
 /// cancels only messages still to come, so a message of the same instant is taken to be.
-fn still_to_come(h: &Handle, time: &VTime) -> bool {
+fn still_to_come<T: Time>(h: &Handle, time: &VTime<T>) -> bool {
     h.uid != 0 && h.t >= time.t()
 }
 
@@ -641,9 +657,9 @@ fn still_to_come(h: &Handle, time: &VTime) -> bool {
 /// after every batch before that one's place: the start of the message's instant, or within the
 /// cancelling batch's instant the first time its message can have (a handle keeps only the
 /// simulation time). A message to an object below `by` comes at a later time than `at`.
-fn not_before(h: &Handle, at: VTime, by: u32) -> VTime {
+fn not_before<T: Time>(h: &Handle, at: VTime<T>, by: u32) -> VTime<T> {
     if h.t > at.t() {
-        VTime::at(Key::start(h.t))
+        VTime::start(h.t)
     } else if h.to < by {
         at.next_gen()
     } else {
@@ -667,7 +683,7 @@ const JOIN_SWEEP: usize = 4;
 
 /// A batch an object ran that is not committed yet.
 struct Done<M: Model> {
-    time: VTime,
+    time: VTime<M::Time>,
     /// The object's state before it.
     pre_state: M::State,
     /// Its kind ([`Model::state_class`]).
@@ -676,7 +692,7 @@ struct Done<M: Model> {
     /// The messages it handled: their names, and the envelopes the model saw.
     inputs: Vec<Input>,
     batch: Vec<Envelope<M::Msg>>,
-    sent: Vec<(Sent, u16)>,
+    sent: Vec<(Sent<M::Time>, u16)>,
     /// The messages it cancelled that were still to come.
     cancels: Vec<Handle>,
     cancel_calls: u32,
@@ -687,7 +703,7 @@ struct Done<M: Model> {
 
 /// What a batch run as final did, for [`Worker::commit_final`].
 struct Did<'a, M: Model> {
-    time: VTime,
+    time: VTime<M::Time>,
     /// The object's count of named messages before it.
     uids: u64,
     /// Messages it handled.
@@ -752,10 +768,10 @@ impl Placement {
 }
 
 /// Chaos mode's state.
-struct Chaos<Msg> {
+struct Chaos<T, Msg> {
     rng: ChaCha8Rng,
     /// Ops held back, with the iteration that releases each.
-    held: Vec<(u64, Op<Msg>)>,
+    held: Vec<(u64, Op<T, Msg>)>,
 }
 
 /// One worker: its objects, its messages, its outboxes.
@@ -764,18 +780,18 @@ pub struct Worker<M: Model> {
     placement: std::sync::Arc<Placement>,
     lps: Vec<Lp<M>>,
     /// Live and marked messages not handled yet.
-    heap: Queue<Item<M::Msg>>,
+    heap: Queue<Item<M::Time, M::Msg>>,
     /// Anti-messages and cancellations, and cancelled messages set aside.
-    marks: Marks<M::Msg>,
+    marks: Marks<M::Time, M::Msg>,
     /// The key of the batch run last: messages for it go to the pending set's instant tier.
-    current: Key,
+    current: M::Time,
     /// Ops for this worker's objects.
-    local_ops: Vec<Op<M::Msg>>,
+    local_ops: Vec<Op<M::Time, M::Msg>>,
     /// Vectors for the next batches.
-    spare: Spare<M::Msg, M::State>,
-    outbox: Vec<Vec<Op<M::Msg>>>,
+    spare: Spare<M::Time, M::Msg, M::State>,
+    outbox: Vec<Vec<Op<M::Time, M::Msg>>>,
     /// Chaos mode: its random stream and the ops it holds back.
-    chaos: Option<Chaos<M::Msg>>,
+    chaos: Option<Chaos<M::Time, M::Msg>>,
     iteration: u64,
     sent_ops: i64,
     received_ops: i64,
@@ -817,13 +833,13 @@ pub struct Worker<M: Model> {
     /// cancellation included, may come at or before it.
     cancel_floor: Floor,
     /// The latest batch run optimistically: no uncommitted batch is later.
-    high: Option<VTime>,
+    high: Option<VTime<M::Time>>,
     /// Below every op in the outboxes.
     outbox_floor: Floor,
     /// What the collector needs of committed batches, until the chunk of the first GVT round
     /// that passes them: the collector puts out a round's batches after the round before's,
     /// and a batch run as final may be later than one another worker commits a round after.
-    to_ship: Vec<Committed<M::State, M::Output>>,
+    to_ship: Vec<Committed<M::Time, M::State, M::Output>>,
 }
 
 /// Why a worker stopped early.
@@ -861,7 +877,7 @@ impl<M: Model> Worker<M> {
             placement,
             heap: Queue::with_capacity(RESERVED_PER_OBJECT * n_objects),
             marks: Marks::default(),
-            current: Key::start(f64::NEG_INFINITY),
+            current: M::Time::start(f64::NEG_INFINITY),
             local_ops: Vec::new(),
             spare: Spare::default(),
             outbox: (0..workers).map(|_| Vec::new()).collect(),
@@ -903,7 +919,7 @@ impl<M: Model> Worker<M> {
 
     /// Runs every object's `init` at `start`; its sends are routed like any others (flush
     /// them with [`Worker::take_outbox`]). Init sends are committed at once.
-    pub fn init(&mut self, model: &M, start: &VTime) {
+    pub fn init(&mut self, model: &M, start: &VTime<M::Time>) {
         for k in 0..self.lps.len() {
             let lp = &mut self.lps[k];
             let (id, first) = (lp.id, lp.uids);
@@ -921,7 +937,7 @@ impl<M: Model> Worker<M> {
 
     /// Takes the ops waiting for workers `to` (uncounted: the caller delivers them itself,
     /// or a fabric counts them).
-    pub fn take_outbox(&mut self, to: std::ops::Range<usize>) -> Vec<(usize, Vec<Op<M::Msg>>)> {
+    pub fn take_outbox(&mut self, to: std::ops::Range<usize>) -> Vec<(usize, Vec<OpOf<M>>)> {
         let mut out = Vec::new();
         for (w, ops) in self.outbox.iter_mut().enumerate() {
             if to.contains(&w) && !ops.is_empty() {
@@ -932,7 +948,7 @@ impl<M: Model> Worker<M> {
     }
 
     /// Accepts ops handed over outside a fabric (at set-up).
-    pub fn accept(&mut self, ops: Vec<Op<M::Msg>>) {
+    pub fn accept(&mut self, ops: Vec<Op<M::Time, M::Msg>>) {
         for op in ops {
             self.apply(op);
         }
@@ -969,7 +985,7 @@ impl<M: Model> Worker<M> {
     }
 
     /// Sends an op on its way.
-    fn route(&mut self, op: Op<M::Msg>) {
+    fn route(&mut self, op: Op<M::Time, M::Msg>) {
         let w = self.placement.worker(op.to());
         if let Op::Anti { .. } = op {
             self.stats.anti_messages += 1;
@@ -993,7 +1009,7 @@ impl<M: Model> Worker<M> {
 
     /// Applies one op, rolling its receiver back if the op changes what the receiver's past
     /// should have seen.
-    fn apply(&mut self, op: Op<M::Msg>) {
+    fn apply(&mut self, op: Op<M::Time, M::Msg>) {
         let (to, (time, obj)) = (op.to(), op.place());
         // a cancellation may come before a batch of messages no one can cancel run as final
         let floor = match op {
@@ -1044,7 +1060,7 @@ impl<M: Model> Worker<M> {
 
     /// A retraction of a message of this worker by the batch of `by` at `at` (the canceller
     /// itself never handled its message, which comes after the batch that cancels it).
-    fn retract(&mut self, h: Handle, at: &VTime, by: u32) {
+    fn retract(&mut self, h: Handle, at: &VTime<M::Time>, by: u32) {
         let unseen = self.marks.cancelled(h.uid);
         // with no batch uncommitted, no batch handled it
         if !self.marks.retract(h.uid) && !unseen && h.to != by && self.high.is_some() {
@@ -1055,7 +1071,7 @@ impl<M: Model> Worker<M> {
 
     /// Rolls local object `li` back if it may have handled a message at `time` that is gone:
     /// the message is back in the heap after this, and its mark drops it there.
-    fn undo_handling(&mut self, li: usize, time: &VTime) {
+    fn undo_handling(&mut self, li: usize, time: &VTime<M::Time>) {
         if self.ran_past(li, time) {
             self.rollback(li, time);
         }
@@ -1063,13 +1079,13 @@ impl<M: Model> Worker<M> {
 
     /// Puts a message in the heap, in the instant's tier if it is for the key being run.
     #[inline(always)]
-    fn push(&mut self, it: Item<M::Msg>) {
+    fn push(&mut self, it: Item<M::Time, M::Msg>) {
         let in_instant = it.p.time.key == self.current;
         self.heap.push(it, in_instant);
     }
 
     /// Undoes every batch of local object `li` at `time` or later.
-    fn rollback(&mut self, li: usize, time: &VTime) {
+    fn rollback(&mut self, li: usize, time: &VTime<M::Time>) {
         self.stats.rollbacks += 1;
         while self.last_time(li).is_some_and(|t| t >= time) {
             let lp = &mut self.lps[li];
@@ -1149,7 +1165,7 @@ impl<M: Model> Worker<M> {
     /// `Some(true)` when every op another worker may still send comes after it, as
     /// `Some(false)` when every message does and no op can change the batch anyway, because
     /// none of its messages can be cancelled (`cancellable` false).
-    fn final_by_bounds(&self, time: &VTime, to: u32, cancellable: bool) -> Option<bool> {
+    fn final_by_bounds(&self, time: &VTime<M::Time>, to: u32, cancellable: bool) -> Option<bool> {
         if self.final_bound.passed(time, to) {
             Some(true)
         } else if !cancellable && self.message_bound.passed(time, to) {
@@ -1167,7 +1183,7 @@ impl<M: Model> Worker<M> {
     fn may_run_final<F: Fabric<M>>(
         &mut self,
         fabric: &F,
-        time: &VTime,
+        time: &VTime<M::Time>,
         to: u32,
         cancellable: bool,
     ) -> Option<bool> {
@@ -1287,7 +1303,7 @@ impl<M: Model> Worker<M> {
         if time.key.depth() > MAX_CASCADE_DEPTH && (run_final || Floor::of(&time, to) <= self.gvt) {
             self.fault.get_or_insert(format!(
                 "a cascade of zero-delay events at t = {} is over {MAX_CASCADE_DEPTH} steps deep \
-                 and does not end (a ball wedged between cushions or balls?)",
+                 and does not end (the model keeps scheduling events at that instant)",
                 time.t()
             ));
         }
@@ -1384,8 +1400,8 @@ impl<M: Model> Worker<M> {
         model: &M,
         li: usize,
         did: Did<'_, M>,
-        sent: &mut Vec<Pending<M::Msg>>,
-        ops: &mut Vec<Op<M::Msg>>,
+        sent: &mut Vec<Pending<M::Time, M::Msg>>,
+        ops: &mut Vec<Op<M::Time, M::Msg>>,
     ) {
         self.count_committed(did.into_past, did.delivered, did.cancelled.len());
         let id = self.lps[li].id;
@@ -1413,7 +1429,7 @@ impl<M: Model> Worker<M> {
     /// straight to the heap: no mark can name it yet, and its receiver needs rolling back only
     /// if it ran ahead of it, which [`Worker::ran_past`] tells at a glance for most messages.
     #[inline(always)]
-    fn send(&mut self, uid: u64, p: Pending<M::Msg>) {
+    fn send(&mut self, uid: u64, p: Pending<M::Time, M::Msg>) {
         self.stats.messages += 1;
         let w = self.placement.worker(p.to);
         if w != self.index {
@@ -1447,12 +1463,12 @@ impl<M: Model> Worker<M> {
     }
 
     /// The time of local object `li`'s latest uncommitted batch.
-    fn last_time(&self, li: usize) -> Option<&VTime> {
+    fn last_time(&self, li: usize) -> Option<&VTime<M::Time>> {
         self.log.last(&self.lps[li].history).map(|d| &d.time)
     }
 
     /// Whether local object `li` ran a batch at `time` or later that is not committed yet.
-    fn ran_past(&self, li: usize, time: &VTime) -> bool {
+    fn ran_past(&self, li: usize, time: &VTime<M::Time>) -> bool {
         // no batch ran past the latest one run: most messages are later than it
         self.high.as_ref().is_some_and(|h| h >= time)
             && self.last_time(li).is_some_and(|t| t >= time)
@@ -1488,7 +1504,7 @@ impl<M: Model> Worker<M> {
     }
 
     /// Takes what arrived; in chaos mode holds it back a few iterations and shuffles it.
-    fn receive<F: Fabric<M>>(&mut self, fabric: &F, buf: &mut Vec<Op<M::Msg>>) {
+    fn receive<F: Fabric<M>>(&mut self, fabric: &F, buf: &mut Vec<Op<M::Time, M::Msg>>) {
         fabric.recv(self.index, buf);
         self.received_ops += buf.len() as i64;
         match &mut self.chaos {
@@ -1503,7 +1519,7 @@ impl<M: Model> Worker<M> {
                     held.push((self.iteration + delay, op));
                 }
                 let now = self.iteration;
-                let mut due: Vec<Op<M::Msg>> = Vec::new();
+                let mut due: Vec<Op<M::Time, M::Msg>> = Vec::new();
                 let mut k = 0;
                 while k < held.len() {
                     if held[k].0 <= now {
@@ -1633,7 +1649,7 @@ impl<M: Model> Worker<M> {
     /// sinks see.
     fn keep_for_collector(
         &mut self,
-        time: VTime,
+        time: VTime<M::Time>,
         obj: u32,
         state: Option<M::State>,
         output: Vec<M::Output>,
@@ -1709,7 +1725,7 @@ impl<M: Model> Worker<M> {
         model: &M,
         gvt: Floor,
         sweep: bool,
-    ) -> Vec<Committed<M::State, M::Output>> {
+    ) -> Vec<Committed<M::Time, M::State, M::Output>> {
         let mut still = Vec::with_capacity(self.active.len());
         for k in 0..self.active.len() {
             let li = self.active[k] as usize;
@@ -1917,6 +1933,7 @@ pub fn chaos_from_env() -> Result<Option<u64>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::PlainTime;
 
     fn handle(to: u32, t: f64) -> Handle {
         Handle {
@@ -2008,7 +2025,7 @@ mod tests {
 
     #[test]
     fn a_cancelled_message_is_still_to_come_from_the_cancelling_instant_on() {
-        let at = VTime::at(Key::start(2.0)).next_gen();
+        let at = VTime::<PlainTime>::start(2.0).next_gen();
         assert!(still_to_come(&handle(3, 2.5), &at));
         assert!(
             still_to_come(&handle(3, 2.0), &at),
@@ -2030,11 +2047,11 @@ mod tests {
 
     #[test]
     fn a_receiver_rolls_back_from_no_earlier_than_the_cancellations_place() {
-        let at = VTime::at(Key::start(2.0)).next_gen();
+        let at = VTime::<PlainTime>::start(2.0).next_gen();
         // a later instant: from its start
         assert_eq!(
             not_before(&handle(3, 2.5), at.clone(), 5),
-            VTime::at(Key::start(2.5))
+            VTime::start(2.5)
         );
         // the same instant, an object after the canceller: from the cancelling batch's time
         assert_eq!(not_before(&handle(7, 2.0), at.clone(), 5), at);

@@ -25,7 +25,7 @@
 
 use super::threads::{Slots, ThreadReduce};
 use super::{Bounds, Chunk, Fabric, Floor, Op, Reduction};
-use crate::kernel::Model;
+use crate::kernel::{Model, Time};
 use mpi::collective::SystemOperation;
 use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::SimpleCommunicator;
@@ -70,23 +70,28 @@ pub fn place() -> (usize, usize) {
 
 /// What travels between ranks.
 #[derive(serde::Serialize, serde::Deserialize)]
-enum Parcel<Msg, S, O> {
+#[serde(bound(
+    serialize = "T: Time, Msg: Serialize, S: Serialize, O: Serialize",
+    deserialize = "T: Time, Msg: DeserializeOwned, S: DeserializeOwned, O: DeserializeOwned"
+))]
+enum Parcel<T, Msg, S, O> {
     /// Ops for global worker `.0`.
-    Ops(usize, Vec<Op<Msg>>),
+    Ops(usize, Vec<Op<T, Msg>>),
     /// A committed chunk for rank 0's collector.
-    Chunk(Box<Chunk<S, O>>),
+    Chunk(Box<Chunk<T, S, O>>),
 }
 
-type ChunkOf<M> = Chunk<<M as Model>::State, <M as Model>::Output>;
+type ChunkOf<M> = Chunk<<M as Model>::Time, <M as Model>::State, <M as Model>::Output>;
 
-type ParcelOf<M> = Parcel<<M as Model>::Msg, <M as Model>::State, <M as Model>::Output>;
+type ParcelOf<M> =
+    Parcel<<M as Model>::Time, <M as Model>::Msg, <M as Model>::State, <M as Model>::Output>;
 
 /// The workers of this rank, and the way to the others.
 pub struct MpiFabric<M: Model> {
     rank: usize,
     ranks: usize,
     per_rank: usize,
-    slots: Slots<M::Msg>,
+    slots: Slots<M::Time, M::Msg>,
     far: Mutex<Far>,
     outgoing: Mutex<Vec<Vec<ParcelOf<M>>>>,
     reduce: ThreadReduce,
@@ -206,7 +211,7 @@ where
     M::State: Serialize + DeserializeOwned + Send,
     M::Output: Serialize + DeserializeOwned + Send,
 {
-    fn send(&self, _from: usize, to: usize, ops: Vec<Op<M::Msg>>) {
+    fn send(&self, _from: usize, to: usize, ops: Vec<Op<M::Time, M::Msg>>) {
         match self.local(to) {
             Some(k) => self.slots.send(k, ops),
             None => {
@@ -221,7 +226,7 @@ where
         }
     }
 
-    fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
+    fn recv(&self, me: usize, into: &mut Vec<Op<M::Time, M::Msg>>) {
         let k = self.local(me).expect("a worker of this rank");
         self.slots.recv(k, into);
     }
@@ -283,7 +288,7 @@ where
         self.rank == 0
     }
 
-    fn commit(&self, chunk: Chunk<M::State, M::Output>) {
+    fn commit(&self, chunk: Chunk<M::Time, M::State, M::Output>) {
         if self.rank == 0 {
             self.deliver(Parcel::Chunk(Box::new(chunk)));
         } else {

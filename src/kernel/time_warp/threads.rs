@@ -3,10 +3,10 @@
 //! batches and feeds them, in order, to the sink.
 
 use super::{
-    Bounds, Chunk, Committed, Fabric, Floor, Op, Placement, Reduction, TwConfig, TwStats, Worker,
+    Bounds, Chunk, CommittedOf, Fabric, Floor, Op, Placement, Reduction, TwConfig, TwStats, Worker,
 };
 use crate::kernel::sequential::Sink;
-use crate::kernel::{MessageStats, Model, VTime};
+use crate::kernel::{MessageStats, Model, Time, VTime};
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{mpsc, Arc, Barrier, Mutex};
@@ -58,9 +58,9 @@ impl ThreadReduce {
 /// A worker's inbox and what bounds it, on cache lines of its own: its worker writes it every
 /// few batches, and a neighbour's writes would otherwise take the line away from under it.
 #[repr(align(128))]
-struct Slot<Msg> {
+struct Slot<T, Msg> {
     /// Ops sent to it, not taken yet; whoever changes `floors` holds this lock.
-    inbox: Mutex<Vec<Op<Msg>>>,
+    inbox: Mutex<Vec<Op<T, Msg>>>,
     /// Whether the inbox may hold ops: its worker takes the lock only then.
     full: AtomicBool,
     /// Its floors, readable without the lock.
@@ -136,11 +136,11 @@ impl Floors {
 
 /// The inboxes of one process's workers and the floors that bound them, shared by the threads
 /// fabric and, within each rank, the MPI one.
-pub(super) struct Slots<Msg> {
-    slots: Vec<Slot<Msg>>,
+pub(super) struct Slots<T, Msg> {
+    slots: Vec<Slot<T, Msg>>,
 }
 
-impl<Msg> Slots<Msg> {
+impl<T: Time, Msg> Slots<T, Msg> {
     /// Empty inboxes for `n` workers, whose floors know nothing yet.
     pub(super) fn new(n: usize) -> Self {
         Slots {
@@ -155,7 +155,7 @@ impl<Msg> Slots<Msg> {
     }
 
     /// Puts `ops` in worker `k`'s inbox, its floor lowered to theirs.
-    pub(super) fn send(&self, k: usize, mut ops: Vec<Op<Msg>>) {
+    pub(super) fn send(&self, k: usize, mut ops: Vec<Op<T, Msg>>) {
         let floor = Op::lowest(&ops);
         let slot = &self.slots[k];
         let mut inbox = slot.inbox.lock().expect("no thread panicked");
@@ -170,7 +170,7 @@ impl<Msg> Slots<Msg> {
     }
 
     /// Moves worker `k`'s inbox into `into`; the worker's own floor takes the inbox's over.
-    pub(super) fn recv(&self, k: usize, into: &mut Vec<Op<Msg>>) {
+    pub(super) fn recv(&self, k: usize, into: &mut Vec<Op<T, Msg>>) {
         let slot = &self.slots[k];
         // ops sent since this worker looked are taken at its next look
         if !slot.full.load(Ordering::Acquire) {
@@ -228,11 +228,11 @@ impl<Msg> Slots<Msg> {
 
 /// Workers as threads of this process.
 pub struct ThreadFabric<M: Model> {
-    slots: Slots<M::Msg>,
+    slots: Slots<M::Time, M::Msg>,
     reduce: ThreadReduce,
     /// GVT rounds asked for so far (by any worker): every worker with fewer behind it starts one.
     rounds_asked: AtomicU64,
-    collector: mpsc::Sender<Chunk<M::State, M::Output>>,
+    collector: mpsc::Sender<Chunk<M::Time, M::State, M::Output>>,
 }
 
 impl<M: Model> ThreadFabric<M>
@@ -240,7 +240,7 @@ where
     M::Msg: Send,
 {
     /// A fabric for `n` workers whose committed chunks go to `collector`.
-    pub fn new(n: usize, collector: mpsc::Sender<Chunk<M::State, M::Output>>) -> Self {
+    pub fn new(n: usize, collector: mpsc::Sender<Chunk<M::Time, M::State, M::Output>>) -> Self {
         ThreadFabric {
             slots: Slots::new(n),
             reduce: ThreadReduce::new(n),
@@ -256,11 +256,11 @@ where
     M::State: Send,
     M::Output: Send,
 {
-    fn send(&self, _from: usize, to: usize, ops: Vec<Op<M::Msg>>) {
+    fn send(&self, _from: usize, to: usize, ops: Vec<Op<M::Time, M::Msg>>) {
         self.slots.send(to, ops);
     }
 
-    fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
+    fn recv(&self, me: usize, into: &mut Vec<Op<M::Time, M::Msg>>) {
         self.slots.recv(me, into);
     }
 
@@ -268,7 +268,7 @@ where
         self.reduce.reduce(me, local)
     }
 
-    fn commit(&self, chunk: Chunk<M::State, M::Output>) {
+    fn commit(&self, chunk: Chunk<M::Time, M::State, M::Output>) {
         // the collector outlives the workers; if it has gone, nobody wants the output
         let _ = self.collector.send(chunk);
     }
@@ -314,7 +314,7 @@ impl Drop for WorkerEnd<'_> {
 }
 
 /// A model's chunk of committed batches.
-type ChunkOf<M> = Chunk<<M as Model>::State, <M as Model>::Output>;
+type ChunkOf<M> = Chunk<<M as Model>::Time, <M as Model>::State, <M as Model>::Output>;
 
 /// Why a Time Warp run stopped early.
 #[derive(Debug)]
@@ -368,7 +368,7 @@ impl<M: Model> Collector<M> {
         &mut self,
         model: &M,
         workers: usize,
-        chunk: Chunk<M::State, M::Output>,
+        chunk: Chunk<M::Time, M::State, M::Output>,
         sink: &mut Sink<'_, M, E>,
         failed: &mut Option<TwError<E>>,
     ) {
@@ -395,7 +395,7 @@ impl<M: Model> Collector<M> {
             if failed.is_some() {
                 continue;
             }
-            let mut batches: Vec<Option<Committed<M::State, M::Output>>> = chunks
+            let mut batches: Vec<Option<CommittedOf<M>>> = chunks
                 .into_iter()
                 .flat_map(|c| c.batches)
                 .map(Some)
@@ -492,7 +492,7 @@ where
     pub fn new(
         model: M,
         states: Vec<M::State>,
-        start: VTime,
+        start: VTime<M::Time>,
         worker_of: &[u32],
         cfg: TwConfig,
     ) -> TimeWarp<M> {
@@ -534,7 +534,7 @@ where
                 .collect()
         });
         // init's sends to this rank's workers are delivered here; others wait in outboxes
-        let mut mail: Vec<Vec<Op<M::Msg>>> = (0..per).map(|_| Vec::new()).collect();
+        let mut mail: Vec<Vec<Op<M::Time, M::Msg>>> = (0..per).map(|_| Vec::new()).collect();
         for w in &mut workers {
             for (to, ops) in w.take_outbox(mine.clone()) {
                 mail[to - mine.start].extend(ops);
@@ -716,13 +716,15 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::time_warp::Committed;
+    use crate::kernel::PlainTime;
     use crate::kernel::{Ctx, Envelope};
-    use crate::vtime::Key;
 
     /// Objects whose state is a number; nothing is ever sent.
     struct Numbers;
 
     impl Model for Numbers {
+        type Time = PlainTime;
         type Msg = ();
         type State = u32;
         type Output = ();
@@ -740,7 +742,11 @@ mod tests {
         fn handle(&self, _: &mut Ctx<'_, Self>, _: u32, _: &mut u32, _: &[Envelope<()>]) {}
     }
 
-    fn chunk(worker: usize, round: u64, batches: Vec<Committed<u32, ()>>) -> Chunk<u32, ()> {
+    fn chunk(
+        worker: usize,
+        round: u64,
+        batches: Vec<Committed<PlainTime, u32, ()>>,
+    ) -> Chunk<PlainTime, u32, ()> {
         Chunk {
             worker,
             round,
@@ -752,7 +758,7 @@ mod tests {
     }
 
     /// A worker's last chunk of a run, with its objects' final states.
-    fn last_chunk(worker: usize, finals: Vec<(u32, u32)>) -> Chunk<u32, ()> {
+    fn last_chunk(worker: usize, finals: Vec<(u32, u32)>) -> Chunk<PlainTime, u32, ()> {
         Chunk {
             last: Some((TwStats::default(), MessageStats::default(), 0)),
             finals,
@@ -760,8 +766,8 @@ mod tests {
         }
     }
 
-    fn at(t: f64) -> VTime {
-        VTime::at(Key::start(t))
+    fn at(t: f64) -> VTime<PlainTime> {
+        VTime::start(t)
     }
 
     #[test]
@@ -867,16 +873,16 @@ mod tests {
         M::State: Send,
         M::Output: Send,
     {
-        fn send(&self, from: usize, to: usize, ops: Vec<Op<M::Msg>>) {
+        fn send(&self, from: usize, to: usize, ops: Vec<Op<M::Time, M::Msg>>) {
             self.0.send(from, to, ops);
         }
-        fn recv(&self, me: usize, into: &mut Vec<Op<M::Msg>>) {
+        fn recv(&self, me: usize, into: &mut Vec<Op<M::Time, M::Msg>>) {
             self.0.recv(me, into);
         }
         fn reduce(&self, me: usize, local: Reduction) -> Reduction {
             self.0.reduce(me, local)
         }
-        fn commit(&self, chunk: Chunk<M::State, M::Output>) {
+        fn commit(&self, chunk: Chunk<M::Time, M::State, M::Output>) {
             self.0.commit(chunk);
         }
         fn shares_floors(&self) -> bool {
@@ -930,7 +936,7 @@ mod tests {
             Ok::<(), ()>(())
         };
         let at = |obj, state: u32, output| Committed {
-            time: VTime::at(Key::start(1.0)),
+            time: VTime::start(1.0),
             obj,
             state: Some(state),
             output,
@@ -1019,6 +1025,7 @@ mod tests {
     const RELAYS: u32 = 48;
 
     impl Model for Relay {
+        type Time = PlainTime;
         type Msg = u64;
         type State = (u64, Option<crate::kernel::Handle>);
         type Output = ();
@@ -1051,7 +1058,7 @@ mod tests {
             let now = ctx.now().clone();
             if now.gen == 1 {
                 let later = VTime {
-                    key: now.key.clone(),
+                    key: now.key,
                     gen: 3,
                 };
                 // to a higher-numbered object of the other worker, so that its batch of
