@@ -9,8 +9,8 @@
 
 use crate::engine::event_list::{EventList, Options};
 use crate::engine::Ignore;
-use crate::model::phold::ROSS_EVENTS_PER_SECOND_PER_CORE;
 use crate::scenario::builtin::{self, Params};
+use pdes_kernel::phold::ROSS_EVENTS_PER_SECOND_PER_CORE;
 use serde_json::json;
 use std::time::Instant;
 
@@ -452,7 +452,7 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         }
     }
     // PHOLD: the sequential kernel, then Time Warp on each worker count, one model throughout
-    let phold_cfg = crate::model::phold::PholdConfig {
+    let phold_cfg = pdes_kernel::phold::PholdConfig {
         objects: a.phold_objects,
         events_per_object: 16,
         remote: 0.1,
@@ -461,14 +461,14 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
         mean: 1.0,
         seed: 1,
     };
-    let mut phold: Vec<crate::model::phold::PholdReport> = Vec::new();
+    let mut phold: Vec<pdes_kernel::phold::PholdReport> = Vec::new();
     for workers in std::iter::once(None).chain(a.tw_workers.iter().map(|&w| Some(w))) {
-        let tw = workers.map(|w| crate::kernel::time_warp::TwConfig {
+        let tw = workers.map(|w| pdes_kernel::time_warp::TwConfig {
             workers: w,
             final_batches: !a.tw_pure,
             ..Default::default()
         });
-        let p = crate::model::phold::run(phold_cfg.clone(), 20.0, tw)?;
+        let p = pdes_kernel::phold::run(phold_cfg.clone(), 20.0, tw)?;
         if let Some(first) = phold
             .first()
             .filter(|f| f.final_state_digest != p.final_state_digest)
@@ -675,7 +675,7 @@ fn time_warp_rows(
                 news: FixedNews::default(),
             },
             w => EngineKind::TimeWarp {
-                tw: crate::kernel::time_warp::TwConfig {
+                tw: pdes_kernel::time_warp::TwConfig {
                     workers: w,
                     final_batches: !pure,
                     ..Default::default()

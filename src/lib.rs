@@ -5,9 +5,8 @@
 //! - [`geometry`] and [`physics`]: pure functions of trajectories (thesis ch. 3);
 //! - [`scenario`]: tables and balls from TOML or built-in generators, validated once;
 //! - [`vtime`]: the lexicographic virtual time that orders simultaneous events exactly;
-//! - [`kernel`]: a generic message-passing kernel (objects, batches, cancellation, statistics),
-//!   run in order or optimistically in parallel by Time Warp (threads, MPI ranks);
-//! - [`model`]: the pool objects and PHOLD as kernel models;
+//! - [`model`]: the pool objects as models of the [`pdes_kernel`] crate, a generic
+//!   message-passing kernel run in order or optimistically in parallel by Time Warp;
 //! - [`engine`]: the event-list, time-step and objects engines;
 //! - [`check`]: invariants checked while a run goes (`--check`);
 //! - [`output`]: the trace, final state and run summary;
@@ -19,7 +18,6 @@ pub mod check;
 pub mod engine;
 pub mod experiment;
 pub mod geometry;
-pub mod kernel;
 pub mod memory;
 pub mod model;
 pub mod output;

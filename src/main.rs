@@ -4,8 +4,8 @@
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
+use pdes_kernel::time_warp::TwConfig;
 use poolsim::engine::{Event, Observer, RunError, World};
-use poolsim::kernel::time_warp::{self, TwConfig};
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};
 use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
@@ -334,7 +334,7 @@ struct PholdArgs {
 const MAX_PHOLD_EVENTS: u64 = 10_000_000;
 
 fn phold(a: &PholdArgs) -> Result<(), Failure> {
-    use poolsim::model::phold::{run, PholdConfig};
+    use pdes_kernel::phold::{run, PholdConfig};
     let positive = |flag: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
             Ok(())
@@ -376,7 +376,7 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
     #[cfg(feature = "mpi")]
     let _mpi = if tw.is_some() { start_mpi()? } else { None };
     let partitions = a.partitions.unwrap_or_else(|| match &tw {
-        Some(c) => poolsim::kernel::time_warp::threads::total_workers(c) as u32,
+        Some(c) => pdes_kernel::time_warp::threads::total_workers(c) as u32,
         None => 2,
     });
     if u64::from(a.objects) * u64::from(a.events_per_object) > MAX_PHOLD_EVENTS {
@@ -406,7 +406,7 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
         tw,
     )
     .map_err(internal)?;
-    if poolsim::kernel::time_warp::threads::place().0 != 0 {
+    if pdes_kernel::time_warp::threads::place().0 != 0 {
         return Ok(());
     }
     if a.json {
@@ -429,7 +429,7 @@ fn phold(a: &PholdArgs) -> Result<(), Failure> {
             report.wall_seconds,
             report.events_per_second,
             report.events_per_second_per_core / 1e6,
-            poolsim::model::phold::ROSS_EVENTS_PER_SECOND_PER_CORE / 1e6,
+            pdes_kernel::phold::ROSS_EVENTS_PER_SECOND_PER_CORE / 1e6,
             report.final_state_digest
         );
         if let Some(t) = &report.time_warp {
@@ -701,7 +701,7 @@ fn start_mpi() -> Result<Option<mpi::environment::Universe>, Failure> {
 fn tw_workers(workers: Option<usize>) -> Result<TwConfig, Failure> {
     let mut tw = TwConfig {
         workers: std::thread::available_parallelism().map_or(1, |n| n.get()),
-        chaos: time_warp::chaos_from_env().map_err(usage)?,
+        chaos: chaos_from_env().map_err(usage)?,
         ..TwConfig::default()
     };
     if let Some(w) = workers {
@@ -845,7 +845,7 @@ fn run(a: &RunArgs) -> Result<(), Failure> {
     #[cfg(feature = "mpi")]
     let _mpi = if time_warp { start_mpi()? } else { None };
     // under MPI only rank 0 writes anything
-    let root = poolsim::kernel::time_warp::threads::collects_results();
+    let root = pdes_kernel::time_warp::threads::collects_results();
     let mut trace = match a.trace.as_ref().filter(|_| root) {
         Some(p) => Some(TraceWriter::new(BufWriter::new(File::create(p).map_err(
             |e| {
@@ -1206,5 +1206,17 @@ fn main() -> ExitCode {
             eprintln!("poolsim: {}", f.message);
             ExitCode::from(f.code)
         }
+    }
+}
+
+/// Seeds for chaos mode from `POOLSIM_CHAOS`, when set to a number.
+fn chaos_from_env() -> Result<Option<u64>, String> {
+    match std::env::var("POOLSIM_CHAOS") {
+        Err(_) => Ok(None),
+        Ok(s) if s.is_empty() => Ok(None),
+        Ok(s) => s
+            .parse()
+            .map(Some)
+            .map_err(|_| format!("POOLSIM_CHAOS: expected a seed (an integer), got `{s}`")),
     }
 }

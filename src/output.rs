@@ -131,17 +131,7 @@ pub fn digest(t: f64, balls: &[BallState]) -> String {
     }))
 }
 
-/// A 64-bit FNV-1a hash, in hex, of a sequence of words (little-endian bytes).
-pub fn fnv_hex(words: impl IntoIterator<Item = u64>) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for x in words {
-        for byte in x.to_le_bytes() {
-            h ^= u64::from(byte);
-            h = h.wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    format!("{h:016x}")
-}
+pub use pdes_kernel::digest::fnv_hex;
 
 /// Event counts by trace kind, as the summary's `events` object.
 pub fn events_json(counts: &crate::engine::EventCounts) -> serde_json::Value {

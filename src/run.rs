@@ -8,7 +8,6 @@ use crate::engine::event_list::{self, EventList};
 use crate::engine::objects::Objects;
 use crate::engine::time_step::{self, TimeStep};
 use crate::engine::{BallState, Event, Frame, Observer, Outcome, RunError, Span, Table, World};
-use crate::kernel::time_warp::{TwConfig, TwStats};
 use crate::model::pool::NvDelay;
 /// Which balls tell the fixed objects of a sectored table (re-exported for engine choices).
 pub use crate::model::sectored::FixedNews;
@@ -18,6 +17,7 @@ use crate::physics::kinetic_energy;
 use crate::polygon::Polygon;
 use crate::scenario::Scenario;
 use crate::scenario::SectorSpec;
+use pdes_kernel::time_warp::{TwConfig, TwStats};
 use serde_json::{json, Value};
 use std::time::Instant;
 
@@ -277,7 +277,7 @@ pub fn execute(
     };
     // every engine ends with a sweep of the state it ends in (a tunnelled ball has no event);
     // under MPI only rank 0 collects the final state
-    let collects = crate::kernel::time_warp::threads::collects_results();
+    let collects = pdes_kernel::time_warp::threads::collects_results();
     if let Some(c) = sinks.checker.as_mut().filter(|_| collects) {
         c.sweep_final(&table, &outcome.balls, outcome.t)?;
     }

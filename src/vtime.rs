@@ -13,7 +13,7 @@
 //! last fixed (the later of the two, extended by the pair), so every engine that holds the same
 //! trajectories computes the same key, however it found the collision.
 
-use crate::kernel::time::{Time, TIE_WORDS};
+use pdes_kernel::time::{Time, TIE_WORDS};
 use smallvec::SmallVec;
 use std::cmp::Ordering;
 

@@ -53,7 +53,7 @@ fn thesis_4_7_returns_every_ball_to_its_start() {
     }
     // Time Warp, plain and sectored, on 2 workers with chaos: the same reversal, bit for bit
     for sectors in [None, Some(poolsim::run::SectorChoice::Grid(2, 2))] {
-        let tw = poolsim::kernel::time_warp::TwConfig {
+        let tw = pdes_kernel::time_warp::TwConfig {
             workers: 2,
             chaos: Some(11),
             ..Default::default()

@@ -2,7 +2,7 @@
 //! without chaos (deliveries delayed and reordered to force rollbacks), the same physical
 //! events in the same order, the same message counts and the same final state, bit for bit.
 
-use poolsim::kernel::time_warp::TwConfig;
+use pdes_kernel::time_warp::TwConfig;
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{TraceLine, TraceRecorder};
 use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
@@ -290,9 +290,9 @@ fn an_instant_commits_as_it_goes() {
 
 #[test]
 fn memory_stays_flat_over_many_gvt_rounds() {
-    use poolsim::kernel::time_warp::threads::TimeWarp;
-    use poolsim::kernel::VTime;
-    use poolsim::model::phold::{Phold, PholdConfig};
+    use pdes_kernel::phold::{Phold, PholdConfig};
+    use pdes_kernel::time_warp::threads::TimeWarp;
+    use pdes_kernel::VTime;
     let cfg = PholdConfig {
         objects: 512,
         events_per_object: 8,

@@ -27,8 +27,8 @@
 //! orders the opened buckets by full [`Key`], so ties within an instant come out as DESIGN.md
 //! says whatever the bucket width.
 
-use crate::kernel::prefetch::prefetch;
 use crate::vtime::Key;
+use pdes_kernel::prefetch::prefetch;
 use std::cmp::Ordering;
 use std::collections::VecDeque;
 

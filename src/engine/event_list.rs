@@ -29,10 +29,10 @@ use super::{
     RunError, Span, Table, World,
 };
 use crate::geometry::Trajectory;
-use crate::kernel::prefetch::{prefetch, prefetch_all};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
+use pdes_kernel::prefetch::{prefetch, prefetch_all};
 use smallvec::SmallVec;
 use std::cmp::Ordering;
 

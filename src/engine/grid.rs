@@ -11,7 +11,7 @@
 
 use super::Table;
 use crate::geometry::Vec2;
-use crate::kernel::prefetch::prefetch;
+use pdes_kernel::prefetch::prefetch;
 
 const NIL: u32 = u32::MAX;
 

@@ -6,13 +6,13 @@ use super::{
     partition, BallState, EventCounts, Frame, InstantCap, Observer, Outcome, RunError, Span, Table,
     World,
 };
-use crate::kernel::sequential::{Sequential, Sink};
-use crate::kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
-use crate::kernel::time_warp::{TwConfig, TwStats};
-use crate::kernel::{MessageStats, Model, VTime};
 use crate::model::pool::{BallInfo, NvDelay, Pool, PoolOutput, PoolState};
 use crate::model::sectored::{Layout, SecState, Sectored};
 use crate::scenario::Scenario;
+use pdes_kernel::sequential::{Sequential, Sink};
+use pdes_kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
+use pdes_kernel::time_warp::{TwConfig, TwStats};
+use pdes_kernel::{MessageStats, Model, VTime};
 
 /// The objects engine over one scenario: plain or sectored.
 pub enum Objects {

@@ -34,10 +34,10 @@
 
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::Trajectory;
-use crate::kernel::{Ctx, Envelope, Model, SentTwo, VTime};
 use crate::physics::{self, Contact};
 use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, DISPLAY, REVERSAL};
+use pdes_kernel::{Ctx, Envelope, Model, SentTwo, VTime};
 use std::sync::Arc;
 
 /// What a ball tells others about itself.

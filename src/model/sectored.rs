@@ -33,11 +33,11 @@
 use super::pool::{cancel_with, BallInfo, Planned, Plans};
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::{Trajectory, Vec2};
-use crate::kernel::{Ctx, Envelope, Model, SentTwo, VTime};
 use crate::physics::{self, Contact};
 use crate::polygon::{self, Polygon};
 use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, DEPARTURE, REVERSAL};
+use pdes_kernel::{Ctx, Envelope, Model, SentTwo, VTime};
 use smallvec::SmallVec;
 use std::sync::Arc;
 

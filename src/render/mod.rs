@@ -29,10 +29,10 @@ use crate::engine::{
     BallState, Event, EventCounts, Frame, Ignore, Observer, RunError, Span, Table, World,
 };
 use crate::geometry::Vec2;
-use crate::kernel::Model;
 use crate::model::sectored::Layout;
 use crate::run::{execute, sector_layout, EngineKind, RunConfig, SectorChoice};
 use crate::scenario::Scenario;
+use pdes_kernel::Model;
 use serde_json::Value;
 use std::fmt;
 use std::path::{Path, PathBuf};

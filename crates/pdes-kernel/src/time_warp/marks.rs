@@ -251,8 +251,8 @@ impl<T: Time, Msg> Marks<T, Msg> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::PlainTime;
-    use crate::kernel::{Envelope, VTime};
+    use crate::PlainTime;
+    use crate::{Envelope, VTime};
 
     fn msg(t: f64) -> Pending<PlainTime, u8> {
         Pending {

@@ -11,11 +11,11 @@
 //! draws from its own seeded random stream, kept in its state, so a run is the same whatever
 //! executes it.
 
-use crate::kernel::sequential::Sequential;
-use crate::kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
-use crate::kernel::time_warp::{TwConfig, TwStats};
-use crate::kernel::{Ctx, Envelope, Model, PlainTime, VTime};
-use crate::output::fnv_hex;
+use crate::digest::fnv_hex;
+use crate::sequential::Sequential;
+use crate::time_warp::threads::{total_workers, TimeWarp, TwError};
+use crate::time_warp::{TwConfig, TwStats};
+use crate::{Ctx, Envelope, Model, PlainTime, VTime};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::convert::Infallible;

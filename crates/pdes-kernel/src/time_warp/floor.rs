@@ -1,9 +1,9 @@
 //! GVT as a place in the order of batches, not only a simulation time.
 //!
 //! Batches run in the order (virtual time, receiver). A GVT that is only a simulation time can
-//! commit nothing of the instant it stands in, and an instant can be long: at t = 0 every ball of
-//! a sectored gas sets out and its trajectory is relayed through the sectors, some hundred
-//! thousand batches at 10^5 balls, which would all wait uncommitted (with their saved states and
+//! commit nothing of the instant it stands in, and an instant can be long: a model whose every
+//! object announces itself to its neighbours at the start, who relay it on, runs some hundred
+//! thousand batches at t = 0 with 10^5 objects, which would all wait uncommitted (with their saved states and
 //! messages) until the instant ended. A [`Floor`] is the smallest (virtual time, receiver) of any
 //! message still to be handled: every later send goes strictly forward in virtual time, so no
 //! batch before the floor can change any more, whatever its time.

@@ -128,7 +128,7 @@ impl<M: Model> Sequential<M> {
     }
 
     /// Drops cancelled messages from the pending set once they are half of it, so that memory
-    /// follows the live messages (a cancelled collision may lie far in the future); what is
+    /// follows the live messages (a cancelled message may lie far in the future); what is
     /// left in the set names messages already delivered, which no longer matter. Amortized
     /// O(1) per cancellation.
     fn sweep_cancelled(&mut self) {
@@ -207,7 +207,7 @@ impl<M: Model> Sequential<M> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::PlainTime;
+    use crate::PlainTime;
 
     /// One object that, every unit of time, schedules a far-future reminder and cancels the
     /// previous one: a pending set that kept cancelled messages would grow with every step.

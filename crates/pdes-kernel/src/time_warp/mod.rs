@@ -1,4 +1,4 @@
-//! The Time Warp executor (Jefferson 1985; thesis 1, 2.3): the kernel's objects run
+//! The Time Warp executor (Jefferson 1985): the kernel's objects run
 //! optimistically in parallel and commit exactly the sequential executor's batches.
 //!
 //! ```text
@@ -87,9 +87,9 @@ pub const THREADS_GVT_INTERVAL: u32 = 2048;
 
 /// Batches between GVT rounds across MPI ranks, unless set: ops for another rank travel only
 /// at rounds, so the interval is also their delay, and a long one makes stragglers. On 2 ranks
-/// on loopback (gas, 1 worker each), 2,048 against 256: 400 balls, efficiency 0.37 against
-/// 0.67 and 0.18 s against 0.09; 9,801 balls to t = 2, 0.97 against 0.99 and 0.94 s against
-/// 0.67; 10^5 balls to t = 0.2, the same (0.98 s).
+/// on loopback (1 worker each; a hard-disk gas relayed through sectors), 2,048 against 256: 400
+/// disks, efficiency 0.37 against 0.67 and 0.18 s against 0.09; 9,801 disks to t = 2, 0.97
+/// against 0.99 and 0.94 s against 0.67; 10^5 disks to t = 0.2, the same (0.98 s).
 pub const ACROSS_RANKS_GVT_INTERVAL: u32 = 256;
 
 /// Time Warp's settings.
@@ -566,10 +566,10 @@ impl<T: Time, Msg, State> Default for Spare<T, Msg, State> {
 /// with `pending` messages waiting: one per message, at least 1,024 and at most 8,192.
 ///
 /// Too narrow, and workers run out of work under the window and ask for rounds (on 16 cores,
-/// on 16 workers: 10^5 balls took 1,100-1,400 rounds and 0.40-0.48 s at 1,024, 350-590 rounds
+/// on 16 workers: a hard-disk gas of 10^5 disks took 1,100-1,400 rounds and 0.40-0.48 s at 1,024, 350-590 rounds
 /// and 0.37-0.44 s at 4,096 or 8,192; PHOLD with 16,384 objects 0.42-0.60 s at 1,024, 0.27-0.32
-/// s at 8,192); too wide, and a small model runs far ahead only to roll back (the 36-ball gas
-/// on 2 workers of this 2-core VM, before the scale of [`AutoWindow`]: median efficiency 0.25
+/// s at 8,192); too wide, and a small model runs far ahead only to roll back (a gas of 36 disks
+/// on 2 workers of a 2-core machine, before the scale of [`AutoWindow`]: median efficiency 0.25
 /// at 1,024, 0.12-0.14 at 4,096-8,192).
 fn window_span(pending: usize) -> f64 {
     (pending as f64).clamp(1024.0, 8192.0)
@@ -584,9 +584,9 @@ fn window_span(pending: usize) -> f64 {
 /// ever more often and each moving GVT ever less (on 16 cores, 14,000 rounds where 300-900
 /// did, and 2-4x the time). The scale halves when a quarter or more of the worker's batches since
 /// the last change were rolled back, down to 1/16, and doubles back to 1 when fewer were. With
-/// the scale and the samples, the 36-ball gas on 2 workers of this 2-core VM ran at median
-/// efficiencies of 0.42 (sectored) and 0.44 (not) over 10 runs, against 0.21 and 0.27 without;
-/// 9,801 balls on 8 and 16 workers sharing its 2 cores at 0.78 and 0.61-0.63, against 0.68
+/// the scale and the samples, a gas of 36 disks on 2 workers of a 2-core machine ran at median
+/// efficiencies of 0.42 (relayed) and 0.44 (not) over 10 runs, against 0.21 and 0.27 without;
+/// 9,801 disks on 8 and 16 workers sharing its 2 cores at 0.78 and 0.61-0.63, against 0.68
 /// and 0.34 (the window of 4x the advance: 0.90 and 0.83, in 1,400-3,000 rounds).
 struct AutoWindow {
     /// The window; infinite until GVT first moves.
@@ -957,7 +957,7 @@ impl<M: Model> Worker<M> {
 
     /// Messages waiting (not handled) on this worker, as the sequential executor counts them:
     /// annulled and cancelled ones not yet discarded included. (Telling them apart would take
-    /// a look-up per message, 20 ms at the end of a 10^5-ball run.)
+    /// a look-up per message, 20 ms at the end of a run of 10^5 objects.)
     pub fn pending_len(&self) -> usize {
         self.heap.len() + self.marks.set_aside_len()
     }
@@ -1778,7 +1778,7 @@ impl<M: Model> Worker<M> {
         // uncommitted batches past which a worker runs only final ones; across ranks at least
         // as many as at the threads' default interval, though rounds come more often there: a
         // worker held back waits for a round, and a round across ranks is a collective of them
-        // all (held back past 512 batches, 2 ranks at 10^5 balls to t = 1 ran 7 % more rounds)
+        // all (held back past 512 batches, 2 ranks with a gas of 10^5 disks to t = 1 ran 7 % more rounds)
         let ahead = 2 * if ranks > 1 {
             interval.max(THREADS_GVT_INTERVAL)
         } else {
@@ -1796,7 +1796,7 @@ impl<M: Model> Worker<M> {
             let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window.width);
             let mut limit = until.min(window);
             // short bursts publish floors often, so that the others' batches can run as final
-            // (8 against 4: 2 workers at 10^5 balls to t = 0.5 ran 4-5 % faster in 13 of 18
+            // (8 against 4: 2 workers with a gas of 10^5 disks to t = 0.5 ran 4-5 % faster in 13 of 18
             // pairs, with 59 % of the batches final against 60 %)
             let burst = match &mut self.chaos {
                 Some(c) => c.rng.gen_range(1..64u32),
@@ -1918,22 +1918,10 @@ impl<M: Model> Worker<M> {
     }
 }
 
-/// Seeds for chaos mode from `POOLSIM_CHAOS`, when set to a number.
-pub fn chaos_from_env() -> Result<Option<u64>, String> {
-    match std::env::var("POOLSIM_CHAOS") {
-        Err(_) => Ok(None),
-        Ok(s) if s.is_empty() => Ok(None),
-        Ok(s) => s
-            .parse()
-            .map(Some)
-            .map_err(|_| format!("POOLSIM_CHAOS: expected a seed (an integer), got `{s}`")),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::PlainTime;
+    use crate::PlainTime;
 
     fn handle(to: u32, t: f64) -> Handle {
         Handle {

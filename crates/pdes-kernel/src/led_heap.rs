@@ -164,7 +164,7 @@ impl<T: Ranked> LedHeap<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::queue::tests::At;
+    use crate::queue::tests::At;
     use proptest::prelude::*;
 
     proptest! {

@@ -25,7 +25,7 @@
 
 use super::threads::{Slots, ThreadReduce};
 use super::{Bounds, Chunk, Fabric, Floor, Op, Reduction};
-use crate::kernel::{Model, Time};
+use crate::{Model, Time};
 use mpi::collective::SystemOperation;
 use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::SimpleCommunicator;

@@ -2,7 +2,7 @@
 //!
 //! A model picks its own time type ([`Model::Time`](super::Model::Time)): [`PlainTime`] (a
 //! simulation time alone) for most models, or a richer one that orders the events of one instant
-//! (pool's lexicographic keys). The kernel wraps it in a [`VTime`] with a generation, so that a
+//! (a lexicographic key, say). The kernel wraps it in a [`VTime`] with a generation, so that a
 //! message sent with zero delay ([`Ctx::send_now`](super::Ctx::send_now)) arrives after the batch
 //! that sent it and before every later time. Messages of equal virtual time are ordered by the
 //! kernel itself: receiver, priority, sender, the sender's send sequence.

@@ -1,6 +1,6 @@
-//! A hint to the processor to start loading a record into cache before it is read: the engines
-//! know which balls an event will touch a little before they touch them, and at a million balls
-//! each of those records is a trip to main memory.
+//! A hint to the processor to start loading a record into cache before it is read: an executor
+//! knows which object runs next a little before it runs, and with a million objects each of
+//! their records is a trip to main memory.
 
 /// Asks the processor to bring the cache line holding `r` closer; does nothing elsewhere.
 #[inline(always)]

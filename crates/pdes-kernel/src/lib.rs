@@ -1,4 +1,7 @@
-//! A generic message-passing discrete-event kernel (thesis 2.3): it knows nothing of pool.
+//! A generic message-passing discrete-event kernel: objects that exchange timestamped messages,
+//! run in order by the [`sequential`] executor or optimistically in parallel by [`time_warp`]
+//! (threads; MPI ranks behind the `mpi` feature). [`phold`], the standard benchmark of parallel
+//! discrete-event simulators, is its benchmark model and example.
 //!
 //! ```text
 //!            send / send_now / send_at                 batch of one key
@@ -10,7 +13,7 @@
 //! A model is a set of objects, each with a state and a behaviour. An object touches nothing but
 //! its own state and the messages it is given; every effect on the rest of the simulation is a
 //! message. The kernel runs an object once per virtual time at which it has messages, with all of
-//! them as one batch ordered by message priority (thesis 4.3.1), then sender, then the sender's
+//! them as one batch ordered by message priority, then sender, then the sender's
 //! send sequence: never by address or hash order.
 //!
 //! Virtual time ([`VTime`]) is the model's own [`Time`] and a generation: a message sent with
@@ -21,7 +24,11 @@
 //! States are `Clone` and kept small so an optimistic executor can save and restore them; each
 //! object's send counter (which names its messages) lives beside its state for the same reason.
 
+#![warn(missing_docs)]
+
+pub mod digest;
 mod led_heap;
+pub mod phold;
 pub mod prefetch;
 pub mod queue;
 pub mod sequential;
@@ -31,8 +38,8 @@ pub mod time_warp;
 pub use time::{PlainTime, Time, VTime};
 
 /// Pending messages an executor reserves room for per object (address space only until used,
-/// so that a pending set that grows to that size never copies itself into fresh pages): the
-/// sectored gas's set-up instant holds about 25 per object.
+/// so that a pending set that grows to that size never copies itself into fresh pages): a
+/// relay model's set-up instant may hold about 25 per object.
 pub const RESERVED_PER_OBJECT: usize = 32;
 
 use serde::de::DeserializeOwned;
@@ -334,7 +341,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     }
 
     /// Sends `msg` to `to` at `time`, as [`Ctx::send_at`], as a message that is never cancelled
-    /// (a relay of news, as the thesis' NewVelocity and VelocityChange: 5.4), so that the
+    /// (a relay of news that stays true), so that the
     /// executor need not look it up among the cancellations.
     pub fn relay_at(&mut self, to: u32, time: VTime<M::Time>, msg: M::Msg) {
         self.post(to, time, msg, false);
@@ -384,7 +391,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
         h
     }
 
-    /// Retracts a message this object sent (one thesis Cancel message), which must still be to
+    /// Retracts a message this object sent (one cancel message), which must still be to
     /// come after this batch: the executors do not check that a message was not delivered
     /// already (Time Warp ignores a message of an earlier instant, and takes one of this
     /// batch's instant to be still to come).
@@ -409,7 +416,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
 pub struct MessageStats {
     /// Sent messages by type index.
     pub sent: Vec<u64>,
-    /// Messages retracted by `cancel` (each one thesis Cancel message).
+    /// Messages retracted by `cancel` (each one cancel message).
     pub cancels: u64,
     /// Batches run (object activations).
     pub batches: u64,

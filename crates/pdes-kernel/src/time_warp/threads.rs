@@ -5,8 +5,8 @@
 use super::{
     Bounds, Chunk, CommittedOf, Fabric, Floor, Op, Placement, Reduction, TwConfig, TwStats, Worker,
 };
-use crate::kernel::sequential::Sink;
-use crate::kernel::{MessageStats, Model, Time, VTime};
+use crate::sequential::Sink;
+use crate::{MessageStats, Model, Time, VTime};
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{mpsc, Arc, Barrier, Mutex};
@@ -679,7 +679,7 @@ where
         let model: &M = model;
         // the collector wakes every few milliseconds, and when the last worker ends: woken by
         // every chunk, it took a worker's core twice per GVT round on a machine with as many
-        // cores as workers (2 workers at 10^5 balls to t = 0.5: median ratios 0.95-1.00 in
+        // cores as workers (2 workers with a gas of 10^5 disks to t = 0.5: median ratios 0.95-1.00 in
         // three sets of 10 pairs)
         let (finished, main) = (AtomicUsize::new(0), std::thread::current());
         std::thread::scope(|scope| {
@@ -716,9 +716,9 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::time_warp::Committed;
-    use crate::kernel::PlainTime;
-    use crate::kernel::{Ctx, Envelope};
+    use crate::time_warp::Committed;
+    use crate::PlainTime;
+    use crate::{Ctx, Envelope};
 
     /// Objects whose state is a number; nothing is ever sent.
     struct Numbers;
@@ -898,7 +898,7 @@ mod tests {
 
     #[test]
     fn an_op_below_a_final_batch_stops_the_run() {
-        use crate::model::phold::{Phold, PholdConfig};
+        use crate::phold::{Phold, PholdConfig};
         let cfg = PholdConfig {
             objects: 96,
             events_per_object: 4,
@@ -982,8 +982,8 @@ mod tests {
 
     #[test]
     fn a_run_taken_up_again_ends_where_one_run_ends() {
-        use crate::kernel::sequential::Sequential;
-        use crate::model::phold::{Phold, PholdConfig};
+        use crate::phold::{Phold, PholdConfig};
+        use crate::sequential::Sequential;
         let cfg = PholdConfig {
             objects: 64,
             events_per_object: 4,
@@ -1027,7 +1027,7 @@ mod tests {
     impl Model for Relay {
         type Time = PlainTime;
         type Msg = u64;
-        type State = (u64, Option<crate::kernel::Handle>);
+        type State = (u64, Option<crate::Handle>);
         type Output = ();
 
         fn kind_names(&self) -> &'static [&'static str] {
@@ -1082,7 +1082,7 @@ mod tests {
 
     #[test]
     fn cancellations_within_an_instant_beside_batches_run_as_final_by_generation() {
-        use crate::kernel::sequential::Sequential;
+        use crate::sequential::Sequential;
         let states = vec![(0, None); RELAYS as usize];
         let mut seq = Sequential::new(Relay, states.clone(), at(0.0));
         seq.run::<()>(1.0, &mut |_, _, _| Ok(())).unwrap();

@@ -15,7 +15,7 @@ const SORT_TOGETHER: usize = 64;
 const SORT_BY_RANK: usize = 64;
 
 /// An item whose order among the items of one instant a few integers give: the instant's tier
-/// sorts its items (the sectored gas's set-up holds millions) comparing these, not the items'
+/// sorts its items (a large model's set-up instant may hold millions) comparing these, not the items'
 /// keys, which takes a tenth less of the set-up.
 pub trait Ranked: Ord {
     /// The integers: for two items of one instant, their ranks compare as the items do.
@@ -50,7 +50,7 @@ fn span(firsts: impl Iterator<Item = u64>) -> (u64, u64) {
 const PERMUTE_AHEAD: usize = 16;
 
 /// Items from which [`sort_by_rank`] first splits them into [`PARTS`] parts by their first rank
-/// words: so many items (88 bytes each in the sectored gas) are far larger than the caches.
+/// words: so many items (88 bytes each in a model with small messages) are far larger than the caches.
 const SPLIT_FROM: usize = 1 << 15;
 
 /// The parts [`sort_by_rank`] splits many items into (a power of two): each part's items lie
@@ -60,7 +60,7 @@ const PARTS: usize = 256;
 /// Sorts items of one instant (fewer than 2^32) by their ranks. Many items are first split in
 /// place into parts by the high bits of their first rank words (an American flag sort: every
 /// item is swapped once into the part it belongs to), then each part is sorted on its own, its
-/// items now close together ([`sort_part`]). The sectored gas's set-up holds millions of items,
+/// items now close together ([`sort_part`]). A large model's set-up instant may hold millions of items,
 /// whose sort compared in place took a quarter of it.
 fn sort_by_rank<T: Ranked>(v: &mut [T]) {
     if v.len() < SPLIT_FROM {
@@ -164,7 +164,7 @@ fn sort_part<T: Ranked>(v: &mut [T]) {
 /// The instant's items: a sorted run taken from its end, a small heap, and the items pushed
 /// since the run was sorted. Within an instant a batch sends only to later generations, so the
 /// pushed items are not needed until the run is spent; they are then sorted once. An instant of
-/// millions of messages, as the sectored gas's set-up, costs one sort instead of a heap
+/// millions of messages, as a large model's set-up, costs one sort instead of a heap
 /// operation each. Items pushed that must come before some of the run go to the heap instead,
 /// so that no order of pushes costs more than a heap would.
 struct Instant<T: Ranked> {
