@@ -693,11 +693,8 @@ fn time_warp_rows(
         };
         let report = execute(&scenario, &cfg, &mut Ignore).map_err(|e| e.to_string())?;
         let s = &report.summary;
-        let tw = &s["time_warp"];
-        let digest = s["final_state_digest"]
-            .as_str()
-            .unwrap_or_default()
-            .to_string();
+        let tw = s.time_warp.as_ref();
+        let digest = s.final_state_digest.clone();
         if let Some(first) = rows.first() {
             if first.digest != digest {
                 return Err(format!(
@@ -719,12 +716,11 @@ fn time_warp_rows(
             // one run: its own speed-up is the median
             median_speedup: speedup,
             events: report.outcome.events.total(),
-            efficiency: tw["efficiency"].as_f64().unwrap_or(1.0),
-            remote_fraction: tw["remote_fraction"].as_f64().unwrap_or(0.0),
-            final_fraction: match (tw["final_batches"].as_f64(), tw["committed"].as_f64()) {
-                (Some(f), Some(c)) if c > 0.0 => f / c,
-                _ => 0.0,
-            },
+            efficiency: tw.map_or(1.0, |tw| tw.efficiency),
+            remote_fraction: tw.map_or(0.0, |tw| tw.remote_fraction),
+            final_fraction: tw.filter(|tw| tw.stats.committed > 0).map_or(0.0, |tw| {
+                tw.stats.final_batches as f64 / tw.stats.committed as f64
+            }),
             digest,
         });
     }

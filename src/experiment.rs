@@ -474,10 +474,7 @@ fn physics(s: &Scenario, n: usize, seed: u64, until: f64) -> Result<PhysicsRecor
         ball_ball: fp.ball_ball,
         ball_cushion: fp.ball_cushion,
         velocity_changes: fp.changes,
-        digest: report.summary["final_state_digest"]
-            .as_str()
-            .unwrap_or_default()
-            .to_string(),
+        digest: report.summary.final_state_digest.clone(),
     })
 }
 
@@ -511,7 +508,7 @@ fn objects(
     let mut walls = vec![report.wall_seconds];
     for _ in 1..repeats.max(1) {
         let again = execute(s, &cfg, &mut Ignore).map_err(fail)?;
-        if again.summary["messages"] != report.summary["messages"] {
+        if again.summary.messages != report.summary.messages {
             return Err(format!(
                 "{n} balls, seed {seed}, sectors {}: a repeated run sent different messages",
                 setting.name()
@@ -521,14 +518,7 @@ fn objects(
     }
     walls.sort_by(f64::total_cmp);
     let wall = walls[walls.len() / 2];
-    let messages = report.summary["messages"]
-        .as_object()
-        .map(|m| {
-            m.iter()
-                .map(|(k, v)| (k.clone(), v.as_u64().unwrap_or(0)))
-                .collect()
-        })
-        .unwrap_or_default();
+    let messages = report.summary.messages.by_name();
     Ok(RunRecord {
         balls: n,
         seed,
@@ -538,10 +528,7 @@ fn objects(
         messages,
         wall_seconds: wall,
         events: report.outcome.events.total(),
-        digest: report.summary["final_state_digest"]
-            .as_str()
-            .unwrap_or_default()
-            .to_string(),
+        digest: report.summary.final_state_digest.clone(),
     })
 }
 

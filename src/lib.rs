@@ -9,7 +9,7 @@
 //!   message-passing kernel run in order or optimistically in parallel by Time Warp;
 //! - [`engine`]: the event-list, time-step and objects engines;
 //! - [`check`]: invariants checked while a run goes (`--check`);
-//! - [`output`]: the trace, final state and run summary;
+//! - [`output`]: the trace and the final state; [`summary`]: the run summary;
 //! - [`memory`]: the one memory setting that depends on the engine (huge pages).
 
 pub mod analytic;
@@ -27,4 +27,5 @@ pub mod render;
 pub mod reversal_study;
 pub mod run;
 pub mod scenario;
+pub mod summary;
 pub mod vtime;

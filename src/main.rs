@@ -10,6 +10,7 @@ use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};
 use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
 use poolsim::scenario::{self, builtin, Scenario};
+use poolsim::summary::RunSummary;
 use std::fs::File;
 use std::io::{BufWriter, IsTerminal};
 use std::path::PathBuf;
@@ -923,62 +924,53 @@ impl<W: std::io::Write> Observer for Sinks<'_, W> {
     }
 }
 
-fn print_summary(summary: &serde_json::Value, json: bool) {
+fn print_summary(s: &RunSummary, json: bool) {
     if json {
-        println!("{summary}");
+        println!("{}", serde_json::to_string(s).expect("plain data"));
         return;
     }
-    let s = summary;
-    println!("scenario      {}", s["scenario"].as_str().unwrap_or(""));
-    println!("engine        {}", s["engine"].as_str().unwrap_or(""));
-    println!("balls         {}", s["balls"]);
-    println!("until         {}", s["until"]);
-    let ev = &s["events"];
+    println!("scenario      {}", s.scenario);
+    println!("engine        {}", s.engine);
+    println!("balls         {}", s.balls);
+    println!("until         {:?}", s.until);
+    let ev = &s.events;
     println!(
         "events        {} (ball-ball {}, ball-cushion {}, ball-corner {}, ball-pocket {})",
-        ev["total"], ev["ball-ball"], ev["ball-cushion"], ev["ball-corner"], ev["ball-pocket"]
+        ev.total, ev.ball_ball, ev.ball_cushion, ev.ball_corner, ev.ball_pocket
     );
-    let ke = &s["kinetic_energy"];
+    let ke = &s.kinetic_energy;
     println!(
-        "energy        initial {}, final {} on the table + {} in pockets (relative drift {:e})",
-        ke["initial"],
-        ke["final"],
-        ke["pocketed"],
-        ke["relative_drift"].as_f64().unwrap_or(0.0)
+        "energy        initial {:?}, final {:?} on the table + {:?} in pockets (relative drift {:e})",
+        ke.initial, ke.end, ke.pocketed, ke.relative_drift
     );
-    println!(
-        "digest        {}",
-        s["final_state_digest"].as_str().unwrap_or("")
-    );
+    println!("digest        {}", s.final_state_digest);
     println!(
         "wall          {:.3} s ({:.3} s set-up), {:.0} events/s{}",
-        s["wall_seconds"].as_f64().unwrap_or(0.0),
-        s["setup_seconds"].as_f64().unwrap_or(0.0),
-        s["events_per_second"].as_f64().unwrap_or(0.0),
-        if s["checked"] == true {
+        s.wall_seconds,
+        s.setup_seconds,
+        s.events_per_second,
+        if s.checked {
             ", invariants checked at every event"
         } else {
             ""
         }
     );
-    let tw = &s["time_warp"];
-    if tw.is_object() {
-        let n = |k: &str| tw[k].as_u64().unwrap_or(0);
-        let share = |k: &str| 100.0 * n(k) as f64 / n("committed").max(1) as f64;
-        let count = |k: &str, one: &str| match n(k) {
+    if let Some(tw) = &s.time_warp {
+        let st = &tw.stats;
+        let count = |n: u64, one: &str| match n {
             1 => format!("1 {one}"),
             m => format!("{m} {one}s"),
         };
         println!(
             "time warp     {} on {}: efficiency {:.3}, {:.0} % of batches final, {} rollbacks, \
              {:.2} % of messages remote, {} GVT rounds",
-            count("workers", "worker"),
-            count("ranks", "rank"),
-            tw["efficiency"].as_f64().unwrap_or(0.0),
-            share("final_batches"),
-            n("rollbacks"),
-            100.0 * tw["remote_fraction"].as_f64().unwrap_or(0.0),
-            n("gvt_rounds")
+            count(st.workers, "worker"),
+            count(st.ranks, "rank"),
+            tw.efficiency,
+            100.0 * st.final_batches as f64 / st.committed.max(1) as f64,
+            st.rollbacks,
+            100.0 * tw.remote_fraction,
+            st.gvt_rounds
         );
     }
 }
@@ -1081,6 +1073,15 @@ fn render(a: &RenderArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// The demo's summary: the run's, with its sector layout and the page it wrote.
+#[derive(serde::Serialize)]
+struct DemoSummary<'a> {
+    #[serde(flatten)]
+    run: &'a RunSummary,
+    sectors: &'static str,
+    page: String,
+}
+
 /// The main job: the thesis' sectored 36-ball gas (plates 9-13: 2 x 2 sectors, frames every 0.1
 /// up to 4) on the objects engine with the thesis' message flow, checked at every event, drawn
 /// as one page with a player.
@@ -1100,22 +1101,28 @@ fn demo(json: bool, out: &std::path::Path) -> Result<(), Failure> {
         )
     };
     let (rec, line) = render_to(&scenario, &cfg, out)?;
-    let mut summary = rec.summary;
-    summary["sectors"] = "2x2".into();
-    summary["page"] = out.display().to_string().into();
-    print_summary(&summary, json);
-    if !json {
-        let m = &summary["messages"];
+    if json {
+        let demo = DemoSummary {
+            run: &rec.summary,
+            sectors: "2x2",
+            page: out.display().to_string(),
+        };
+        println!("{}", serde_json::to_string(&demo).expect("plain data"));
+        return Ok(());
+    }
+    print_summary(&rec.summary, false);
+    {
+        let m = &rec.summary.messages;
         println!(
             "messages      {} (thesis table 5 total: NewVelocity {}, Collision {}, Cancel {}, \
              VelocityChange {}, SectorEntry {}, SectorDeparture {})",
-            m["total"],
-            m["NewVelocity"],
-            m["Collision"],
-            m["Cancel"],
-            m["VelocityChange"],
-            m["SectorEntry"],
-            m["SectorDeparture"]
+            m.total,
+            m.NewVelocity,
+            m.Collision,
+            m.Cancel,
+            m.VelocityChange,
+            m.SectorEntry,
+            m.SectorDeparture
         );
         println!("sectors       2 x 2 (thesis plates 9-13)");
         println!("page          {line}");

@@ -1,7 +1,7 @@
 //! Sinks for what a run produces: the trace (JSON Lines), the final state (JSON), the bit-exact
 //! digest of the final state, and event counting. Formats are the contracts of DESIGN.md.
 
-use crate::engine::{BallState, Event, EventKind, Observer, RunError, Table, World};
+use crate::engine::{BallState, Event, Observer, RunError, Table, World};
 use serde::Serialize;
 use std::io::Write;
 
@@ -132,13 +132,3 @@ pub fn digest(t: f64, balls: &[BallState]) -> String {
 }
 
 pub use pdes_kernel::digest::fnv_hex;
-
-/// Event counts by trace kind, as the summary's `events` object.
-pub fn events_json(counts: &crate::engine::EventCounts) -> serde_json::Value {
-    let mut m = serde_json::Map::new();
-    for k in EventKind::ALL {
-        m.insert(k.name().to_string(), counts.get(k).into());
-    }
-    m.insert("total".into(), counts.total().into());
-    serde_json::Value::Object(m)
-}

@@ -1,4 +1,4 @@
-//! One run of one engine on one scenario, with its sinks, and the run summary of DESIGN.md.
+//! One run of one engine on one scenario, with its sinks, and its [`RunSummary`].
 //!
 //! This is the whole pipeline `scenario → engine → committed events → sinks` behind
 //! `poolsim run`, `poolsim demo` and `poolsim bench`; the binary only parses arguments.
@@ -12,13 +12,13 @@ use crate::model::pool::NvDelay;
 /// Which balls tell the fixed objects of a sectored table (re-exported for engine choices).
 pub use crate::model::sectored::FixedNews;
 use crate::model::sectored::Layout;
-use crate::output::{digest, events_json};
+use crate::output::digest;
 use crate::physics::kinetic_energy;
 use crate::polygon::Polygon;
 use crate::scenario::Scenario;
 use crate::scenario::SectorSpec;
+use crate::summary::{EventTotals, KineticEnergy, MessageCounts, RunSummary, TimeWarpSummary};
 use pdes_kernel::time_warp::{TwConfig, TwStats};
-use serde_json::{json, Value};
 use std::time::Instant;
 
 /// Which engine runs.
@@ -128,7 +128,7 @@ pub struct Report {
     /// The largest relative energy drift the checker saw, when checking.
     pub max_energy_drift: Option<f64>,
     /// The run summary (`--json`).
-    pub summary: Value,
+    pub summary: RunSummary,
 }
 
 /// Total kinetic energy of balls on the table, and of balls carried into pockets.
@@ -285,35 +285,32 @@ pub fn execute(
     let (e0, _) = energies(&initial);
     let (e1, ep) = energies(&outcome.balls);
     let n_events = outcome.events.total();
-    let mut stats = serde_json::Map::new();
-    for (k, v) in &outcome.engine_stats {
-        stats.insert((*k).to_string(), json!(v));
-    }
+    let engine_stats = outcome
+        .engine_stats
+        .iter()
+        .map(|(k, v)| ((*k).to_string(), *v))
+        .collect();
     let max_drift = sinks.checker.as_ref().map(|c| c.max_energy_drift);
-    let summary = json!({
-        "scenario": scenario.name,
-        "engine": cfg.engine.name(),
-        "balls": scenario.balls.len(),
-        "until": cfg.until,
-        "events": events_json(&outcome.events),
-        "messages": messages_json(&outcome.messages),
-        "kinetic_energy": {
-            "initial": e0,
-            "final": e1,
-            "pocketed": ep,
-            "relative_drift": if e0 > 0.0 { (e1 + ep - e0) / e0 } else { 0.0 },
+    let summary = RunSummary {
+        scenario: scenario.name.clone(),
+        engine: cfg.engine.name().to_string(),
+        balls: scenario.balls.len(),
+        until: cfg.until,
+        events: EventTotals::from(&outcome.events),
+        messages: MessageCounts::from_named(&outcome.messages),
+        kinetic_energy: KineticEnergy::new(e0, e1, ep),
+        final_state_digest: digest(outcome.t, &outcome.balls),
+        wall_seconds: wall,
+        setup_seconds: setup,
+        events_per_second: if wall > 0.0 {
+            n_events as f64 / wall
+        } else {
+            0.0
         },
-        "final_state_digest": digest(outcome.t, &outcome.balls),
-        "wall_seconds": wall,
-        "setup_seconds": setup,
-        "events_per_second": if wall > 0.0 { n_events as f64 / wall } else { 0.0 },
-        "checked": cfg.check,
-        "engine_stats": stats,
-    });
-    let mut summary = summary;
-    if let Some(tw) = &time_warp {
-        summary["time_warp"] = time_warp_json(tw);
-    }
+        checked: cfg.check,
+        engine_stats,
+        time_warp: time_warp.map(|tw| TimeWarpSummary::new(tw, crate::bench::peak_rss_mib())),
+    };
     Ok(Report {
         outcome,
         wall_seconds: wall,
@@ -321,54 +318,6 @@ pub fn execute(
         max_energy_drift: max_drift,
         summary,
     })
-}
-
-/// The summary's `time_warp` object.
-pub fn time_warp_json(tw: &TwStats) -> Value {
-    let mut v = serde_json::to_value(tw).expect("plain numbers");
-    v["efficiency"] = json!(tw.efficiency());
-    v["remote_fraction"] = json!(if tw.messages > 0 {
-        tw.remote_messages as f64 / tw.messages as f64
-    } else {
-        0.0
-    });
-    v["peak_rss_mib"] = json!(crate::bench::peak_rss_mib());
-    v
-}
-
-/// The thesis' message types that count towards its totals (table 5).
-const THESIS_TOTAL: [&str; 6] = [
-    "VelocityChange",
-    "NewVelocity",
-    "SectorDeparture",
-    "SectorEntry",
-    "Cancel",
-    "Collision",
-];
-
-/// The summary's `messages` object: every type DESIGN.md names, zero where the engine sends none
-/// (the event-list and time-step engines send no messages at all), and the thesis' `total`.
-fn messages_json(sent: &[(&'static str, u64)]) -> Value {
-    let count = |name: &str| sent.iter().find(|(n, _)| *n == name).map_or(0, |(_, c)| *c);
-    let mut m = serde_json::Map::new();
-    for name in [
-        "NewVelocity",
-        "Collision",
-        "Cancel",
-        "VelocityChange",
-        "SectorEntry",
-        "SectorDeparture",
-        "VelocityInitialization",
-        "DisplayYourself",
-        "ReverseYourself",
-        "ReturnToTable",
-        "CollisionConfirm",
-    ] {
-        m.insert(name.into(), count(name).into());
-    }
-    let total: u64 = THESIS_TOTAL.iter().map(|n| count(n)).sum();
-    m.insert("total".into(), total.into());
-    Value::Object(m)
 }
 
 /// What a reversal run (thesis 4.6–4.7) found.

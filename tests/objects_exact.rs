@@ -19,7 +19,7 @@ fn run(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>, serde_
         span: Default::default(),
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
-    (rec.lines, report.summary)
+    (rec.lines, serde_json::to_value(&report.summary).unwrap())
 }
 
 fn assert_same(s: &Scenario) {
@@ -228,7 +228,7 @@ fn projector_frames_match_the_event_list() {
             let mut frames = Frames::default();
             let report = execute(&s, &cfg, &mut frames).unwrap();
             got.push(frames.0);
-            summaries.push(report.summary);
+            summaries.push(serde_json::to_value(&report.summary).unwrap());
         }
         let expected = (s.until / 0.25) as usize + 1;
         assert_eq!(got[0].len(), expected, "{name}");

@@ -8,6 +8,7 @@ use poolsim::render::svg::{self, Style};
 use poolsim::render::{html, record, write, Output, Recording, RenderConfig};
 use poolsim::run::{EngineKind, SectorChoice};
 use poolsim::scenario::{self, builtin::Params, Scenario};
+use poolsim::summary::MessageCounts;
 use std::path::Path;
 use std::process::Command;
 
@@ -240,17 +241,11 @@ fn the_history_gives_the_engines_frames_and_the_messages_add_up() {
     let totals: Vec<u64> = rec
         .shots
         .iter()
-        .map(|s| {
-            poolsim::render::messages_json(s.messages.as_ref().unwrap())["total"]
-                .as_u64()
-                .unwrap()
-        })
+        .map(|s| MessageCounts::from_named(s.messages.as_ref().unwrap()).total)
         .collect();
     assert!(totals.windows(2).all(|w| w[0] <= w[1]), "{totals:?}");
-    let last = poolsim::render::messages_json(rec.shots.last().unwrap().messages.as_ref().unwrap());
-    for (name, count) in rec.summary["messages"].as_object().unwrap() {
-        assert_eq!(last.get(name).unwrap_or(&0.into()), count, "{name}");
-    }
+    let last = MessageCounts::from_named(rec.shots.last().unwrap().messages.as_ref().unwrap());
+    assert_eq!(last, rec.summary.messages);
 }
 
 #[test]

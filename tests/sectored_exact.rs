@@ -19,7 +19,7 @@ fn run(s: &Scenario, engine: EngineKind) -> (Vec<TraceLine>, serde_json::Value) 
         span: Default::default(),
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
-    (rec.lines, report.summary)
+    (rec.lines, serde_json::to_value(&report.summary).unwrap())
 }
 
 fn assert_same(s: &Scenario, sectors: SectorChoice) {

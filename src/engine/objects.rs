@@ -10,9 +10,9 @@ use crate::model::pool::{BallInfo, NvDelay, Pool, PoolOutput, PoolState};
 use crate::model::sectored::{Layout, SecState, Sectored};
 use crate::scenario::Scenario;
 use pdes_kernel::sequential::{Sequential, Sink};
-use pdes_kernel::time_warp::threads::{total_workers, TimeWarp, TwError};
+use pdes_kernel::time_warp::threads::{total_workers, TimeWarp};
 use pdes_kernel::time_warp::{TwConfig, TwStats};
-use pdes_kernel::{MessageStats, Model, VTime};
+use pdes_kernel::{ExecError, Executor, MessageStats, Model, VTime};
 
 /// The objects engine over one scenario: plain or sectored.
 pub enum Objects {
@@ -22,99 +22,37 @@ pub enum Objects {
     Sectored(Exec<Sectored>),
 }
 
-/// The executor that runs the objects.
-pub enum Exec<M: Model> {
-    /// One batch at a time, in order.
-    Sequential(Box<Sequential<M>>),
-    /// Optimistically in parallel.
-    TimeWarp(Box<TimeWarp<M>>),
-}
+/// The executor that runs the objects: sequential or Time Warp.
+pub type Exec<M> = Box<dyn Executor<M, RunError>>;
 
-impl<M> Exec<M>
+/// The sequential executor, or Time Warp with `tw` and the objects' workers `worker_of`.
+fn exec<M>(model: M, states: Vec<M::State>, start: f64, tw: Option<(TwConfig, Vec<u32>)>) -> Exec<M>
 where
-    M: Model + Sync,
+    M: Model + Sync + 'static,
     M::Msg: Send,
     M::State: Send + Sync,
     M::Output: Send,
 {
-    /// The sequential executor, or Time Warp with `tw` and the objects' workers `worker_of`.
-    fn new(model: M, states: Vec<M::State>, start: f64, tw: Option<(TwConfig, Vec<u32>)>) -> Self {
-        let start = VTime::start(start);
-        match tw {
-            None => Exec::Sequential(Box::new(Sequential::new(model, states, start))),
-            Some((cfg, worker_of)) => Exec::TimeWarp(Box::new(TimeWarp::new(
-                model, states, start, &worker_of, cfg,
-            ))),
-        }
+    let start = VTime::start(start);
+    match tw {
+        None => Box::new(Sequential::new(model, states, start)),
+        Some((cfg, worker_of)) => Box::new(TimeWarp::new(model, states, start, &worker_of, cfg)),
     }
+}
 
-    /// Frees the executor (Time Warp's workers each on its own thread).
-    fn free(self) {
-        match self {
-            Exec::Sequential(e) => drop(e),
-            Exec::TimeWarp(e) => e.free(),
-        }
-    }
-
-    /// The model.
-    pub fn model(&self) -> &M {
-        match self {
-            Exec::Sequential(e) => e.model(),
-            Exec::TimeWarp(e) => e.model(),
-        }
-    }
-
-    /// The objects' (committed) states.
-    pub fn states(&self) -> &[M::State] {
-        match self {
-            Exec::Sequential(e) => e.states(),
-            Exec::TimeWarp(e) => e.states(),
-        }
-    }
-
-    /// Committed message statistics.
-    pub fn stats(&self) -> &MessageStats {
-        match self {
-            Exec::Sequential(e) => e.stats(),
-            Exec::TimeWarp(e) => e.stats(),
-        }
-    }
-
-    /// Messages waiting, cancelled ones not yet discarded included.
-    pub fn pending_len(&self) -> usize {
-        match self {
-            Exec::Sequential(e) => e.pending_len(),
-            Exec::TimeWarp(e) => e.pending_len(),
-        }
-    }
-
-    /// Time Warp's statistics, under Time Warp.
-    pub fn tw_stats(&self) -> Option<TwStats> {
-        match self {
-            Exec::Sequential(_) => None,
-            Exec::TimeWarp(e) => Some(e.tw_stats()),
-        }
-    }
-
-    /// Runs every batch up to `until`, each output to `sink`, which reads the balls' states
-    /// only if `reads_balls`.
-    fn run(
-        &mut self,
-        until: f64,
-        reads_balls: bool,
-        sink: &mut Sink<'_, M, RunError>,
-    ) -> Result<(), RunError> {
-        match self {
-            Exec::Sequential(e) => e.run(until, sink),
-            Exec::TimeWarp(e) => {
-                e.ship_states(reads_balls);
-                e.run(until, sink).map_err(|e| match e {
-                    TwError::Sink(e) => e,
-                    TwError::Failed(m) => RunError::TimeWarp(m),
-                })
-            }
-        }
-    }
+/// Runs every batch up to `until`, each output to `sink`, which reads the balls' states only if
+/// `reads_balls`.
+fn run_exec<M: Model>(
+    e: &mut Exec<M>,
+    until: f64,
+    reads_balls: bool,
+    sink: &mut Sink<'_, M, RunError>,
+) -> Result<(), RunError> {
+    e.observe_states(reads_balls);
+    e.run(until, sink).map_err(|e| match e {
+        ExecError::Sink(e) => e,
+        ExecError::Failed(m) => RunError::TimeWarp(m),
+    })
 }
 
 /// The ball part of an object's state.
@@ -188,7 +126,7 @@ impl Objects {
             w.resize(states.len(), 0);
             (c, w)
         });
-        Objects::Plain(Exec::new(model, states, span.start, tw))
+        Objects::Plain(exec(model, states, span.start, tw))
     }
 
     /// Sets the sectored objects up at `span.start` over `layout`, sequential.
@@ -206,7 +144,7 @@ impl Objects {
             (c, w)
         });
         let (model, states) = Sectored::new(s, layout, span, threads);
-        Objects::Sectored(Exec::new(model, states, span.start, tw))
+        Objects::Sectored(exec(model, states, span.start, tw))
     }
 
     /// Message statistics so far.
@@ -241,7 +179,8 @@ impl Objects {
             Objects::Sectored(e) => {
                 let mut counts = EventCounts::default();
                 let mut instant = InstantCap::new(e.model().table().n_balls as usize);
-                e.run(
+                run_exec(
+                    e,
                     until,
                     obs.reads_balls(),
                     &mut |model: &Sectored, states, ev| {
@@ -263,10 +202,8 @@ impl Objects {
 /// The end of a run of either model: balls at `until` and the message counts.
 fn outcome<M>(e: &Exec<M>, table: &Table, until: f64, counts: EventCounts) -> Outcome
 where
-    M: Model + Sync,
-    M::Msg: Send,
-    M::State: Send + Sync + BallOf,
-    M::Output: Send,
+    M: Model,
+    M::State: BallOf,
 {
     let view = View {
         table,
@@ -316,7 +253,8 @@ fn run_plain(
         // A frame is complete when every ball has drawn itself for it.
         let mut frame: Option<Frame> = None;
         let mut instant = InstantCap::new(n);
-        exec.run(
+        run_exec(
+            exec,
             until,
             obs.reads_balls(),
             &mut |model: &Pool, states, out| match out {

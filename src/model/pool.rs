@@ -32,6 +32,7 @@
 //! this mode shows the thesis' errors: lost updates in simultaneous collisions (table 2), balls
 //! compressed into each other, and tunneling above `(r1 + r2) / d`.
 
+use super::MessageKind;
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::Trajectory;
 use crate::physics::{self, Contact};
@@ -599,13 +600,14 @@ impl Model for Pool {
     type Output = PoolOutput;
 
     fn kind_names(&self) -> &'static [&'static str] {
-        &[
-            "NewVelocity",
-            "Collision",
-            "ReverseYourself",
-            "ReturnToTable",
-            "DisplayYourself",
-        ]
+        const NAMES: [&str; 5] = [
+            MessageKind::NewVelocity.name(),
+            MessageKind::Collision.name(),
+            MessageKind::ReverseYourself.name(),
+            MessageKind::ReturnToTable.name(),
+            MessageKind::DisplayYourself.name(),
+        ];
+        &NAMES
     }
 
     fn kind(&self, msg: &PoolMsg) -> usize {

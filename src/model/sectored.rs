@@ -31,6 +31,7 @@
 //! those of the event-list engine.
 
 use super::pool::{cancel_with, BallInfo, Planned, Plans};
+use super::MessageKind;
 use crate::engine::{Event, EventKind, Fixed, Span, Table};
 use crate::geometry::{Trajectory, Vec2};
 use crate::physics::{self, Contact};
@@ -310,15 +311,15 @@ pub enum SecMsg {
 }
 
 const KIND_NAMES: [&str; 9] = [
-    "NewVelocity",
-    "Collision",
-    "VelocityChange",
-    "SectorEntry",
-    "SectorDeparture",
-    "VelocityInitialization",
-    "CollisionConfirm",
-    "ReverseYourself",
-    "ReturnToTable",
+    MessageKind::NewVelocity.name(),
+    MessageKind::Collision.name(),
+    MessageKind::VelocityChange.name(),
+    MessageKind::SectorEntry.name(),
+    MessageKind::SectorDeparture.name(),
+    MessageKind::VelocityInitialization.name(),
+    MessageKind::CollisionConfirm.name(),
+    MessageKind::ReverseYourself.name(),
+    MessageKind::ReturnToTable.name(),
 ];
 
 /// A sector's scheduled entry or departure of one ball.

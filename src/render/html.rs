@@ -13,8 +13,9 @@
 //! `<pre id="poolsim-state">` (for `chromium --headless --dump-dom`).
 
 use super::svg::{self, colour, pocket_anchor, sector_anchor, Anchor, Style, View};
-use super::{format_time, messages_json, Recording, Scene};
+use super::{format_time, Recording, Scene};
 use crate::engine::{BallState, EventKind, Fixed};
+use crate::summary::MessageCounts;
 use serde_json::{json, Value};
 
 /// Frames keep their ball positions (`[x, y, vx, vy, pocket]`) beside the history up to this
@@ -103,7 +104,7 @@ pub fn data(rec: &Recording) -> Value {
             let mut f = json!({
                 "t": s.frame.t,
                 "events": s.events.by_kind,
-                "messages": s.messages.as_ref().map(|m| messages_json(m)),
+                "messages": s.messages.as_deref().map(MessageCounts::from_named),
             });
             if positions {
                 f["balls"] = s.frame.balls.iter().map(ball_json).collect();

@@ -32,8 +32,8 @@ use crate::geometry::Vec2;
 use crate::model::sectored::Layout;
 use crate::run::{execute, sector_layout, EngineKind, RunConfig, SectorChoice};
 use crate::scenario::Scenario;
+use crate::summary::RunSummary;
 use pdes_kernel::Model;
-use serde_json::Value;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -46,16 +46,6 @@ pub const MAX_FRAME_BALLS: usize = 2_000_000;
 /// The most trajectory pieces a recording keeps as its history by default; past this the HTML
 /// player interpolates between frames instead (a piece is about 130 bytes of the page).
 pub const MAX_HISTORY: usize = 250_000;
-
-/// The message types whose sum is the thesis' total (table 5).
-pub const THESIS_MESSAGES: [&str; 6] = [
-    "VelocityChange",
-    "NewVelocity",
-    "SectorDeparture",
-    "SectorEntry",
-    "Cancel",
-    "Collision",
-];
 
 /// What to draw and how to run: the engine, the end time and the frame time.
 #[derive(Clone, Debug)]
@@ -202,7 +192,7 @@ pub struct Recording {
     /// The exact history, unless it was longer than the cap (`RenderConfig::max_history`).
     pub history: Option<History>,
     /// The run summary (as `poolsim run --json` prints it).
-    pub summary: Value,
+    pub summary: RunSummary,
 }
 
 /// Records what a run shows: frames with the event counts at their times, and the history.
@@ -691,21 +681,6 @@ pub fn centroid(points: &[Vec2]) -> Vec2 {
         let s = points.iter().fold(Vec2::ZERO, |s, p| s + *p);
         Vec2::new(s.x / n.max(1) as f64, s.y / n.max(1) as f64)
     }
-}
-
-/// Messages as JSON: every type, and the thesis' `total`.
-pub fn messages_json(messages: &[(&'static str, u64)]) -> Value {
-    let mut m = serde_json::Map::new();
-    for (name, count) in messages {
-        m.insert((*name).to_string(), (*count).into());
-    }
-    let total: u64 = messages
-        .iter()
-        .filter(|(n, _)| THESIS_MESSAGES.contains(n))
-        .map(|(_, c)| c)
-        .sum();
-    m.insert("total".into(), total.into());
-    Value::Object(m)
 }
 
 #[cfg(test)]

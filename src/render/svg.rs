@@ -11,9 +11,10 @@
 //! `(left + (x - lo_x)·scale, top + (hi_y - y)·scale)`. Balls and vectors carry `data-ball`
 //! with the ball's name.
 
-use super::{centroid, format_time, messages_json, sectors_of, Scene, Shot};
+use super::{centroid, format_time, sectors_of, Scene, Shot};
 use crate::engine::{BallState, EventKind, Fixed};
 use crate::geometry::Vec2;
+use crate::summary::MessageCounts;
 use std::fmt::Write;
 
 /// The longer side of the table, in pixels.
@@ -445,7 +446,7 @@ pub fn counts_lines(shot: &Shot) -> Vec<String> {
         e.get(EventKind::BallPocket)
     )];
     if let Some(m) = &shot.messages {
-        let total = messages_json(m)["total"].as_u64().unwrap_or(0);
+        let total = MessageCounts::from_named(m).total;
         let parts: Vec<String> = m
             .iter()
             .filter(|(_, c)| *c > 0)

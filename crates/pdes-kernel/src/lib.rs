@@ -27,6 +27,7 @@
 #![warn(missing_docs)]
 
 pub mod digest;
+pub mod executor;
 mod led_heap;
 pub mod phold;
 pub mod prefetch;
@@ -35,6 +36,7 @@ pub mod sequential;
 pub mod time;
 pub mod time_warp;
 
+pub use executor::{ExecError, Executor};
 pub use time::{PlainTime, Time, VTime};
 
 /// Pending messages an executor reserves room for per object (address space only until used,

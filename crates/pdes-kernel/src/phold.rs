@@ -13,9 +13,9 @@
 
 use crate::digest::fnv_hex;
 use crate::sequential::Sequential;
-use crate::time_warp::threads::{total_workers, TimeWarp, TwError};
+use crate::time_warp::threads::{total_workers, TimeWarp};
 use crate::time_warp::{TwConfig, TwStats};
-use crate::{Ctx, Envelope, Model, PlainTime, VTime};
+use crate::{Ctx, Envelope, ExecError, Executor, Model, PlainTime, VTime};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::convert::Infallible;
@@ -202,28 +202,21 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
     let (model, states) = Phold::new(cfg);
     let t0 = VTime::start(0.0);
     let never = |_: &Phold, _: &[PholdState], _: ()| -> Result<(), Infallible> { Ok(()) };
-    let (stats, finals, time_warp) = match tw {
-        None => {
-            let mut ex = Sequential::new(model, states, t0);
-            let Ok(()) = ex.run(end, &mut { never });
-            (ex.stats().clone(), ex.states().to_vec(), None)
-        }
+    let mut ex: Box<dyn Executor<Phold, Infallible>> = match tw {
+        None => Box::new(Sequential::new(model, states, t0)),
         Some(c) => {
             let total = total_workers(&c) as u64;
             let worker_of: Vec<u32> = (0..objects)
                 .map(|o| (u64::from(o) * total / u64::from(objects)) as u32)
                 .collect();
-            let mut ex = TimeWarp::new(model, states, t0, &worker_of, c);
-            if let Err(TwError::Failed(m)) = ex.run(end, &mut { never }) {
-                return Err(m);
-            }
-            (
-                ex.stats().clone(),
-                ex.states().to_vec(),
-                Some(ex.tw_stats()),
-            )
+            Box::new(TimeWarp::new(model, states, t0, &worker_of, c))
         }
     };
+    if let Err(ExecError::Failed(m)) = ex.run(end, &mut { never }) {
+        return Err(m);
+    }
+    let (stats, finals, time_warp) = (ex.stats().clone(), ex.states().to_vec(), ex.tw_stats());
+    ex.free();
     let wall = start.elapsed().as_secs_f64();
     let committed = stats.delivered;
     let events_per_second = committed as f64 / wall.max(1e-9);

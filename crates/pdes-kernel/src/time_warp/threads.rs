@@ -5,6 +5,7 @@
 use super::{
     Bounds, Chunk, CommittedOf, Fabric, Floor, Op, Placement, Reduction, TwConfig, TwStats, Worker,
 };
+use crate::executor::ExecError;
 use crate::sequential::Sink;
 use crate::{MessageStats, Model, Time, VTime};
 use std::collections::BTreeMap;
@@ -316,15 +317,6 @@ impl Drop for WorkerEnd<'_> {
 /// A model's chunk of committed batches.
 type ChunkOf<M> = Chunk<<M as Model>::Time, <M as Model>::State, <M as Model>::Output>;
 
-/// Why a Time Warp run stopped early.
-#[derive(Debug)]
-pub enum TwError<E> {
-    /// The sink returned an error.
-    Sink(E),
-    /// A worker failed: out of its memory budget, or a model bug committed.
-    Failed(String),
-}
-
 /// Committed batches of one round from every worker, merged and fed to the sink.
 pub struct Collector<M: Model> {
     states: Vec<M::State>,
@@ -370,7 +362,7 @@ impl<M: Model> Collector<M> {
         workers: usize,
         chunk: Chunk<M::Time, M::State, M::Output>,
         sink: &mut Sink<'_, M, E>,
-        failed: &mut Option<TwError<E>>,
+        failed: &mut Option<ExecError<E>>,
     ) {
         if let Some((stats, messages, pending)) = &chunk.last {
             self.stats.add(stats);
@@ -379,7 +371,7 @@ impl<M: Model> Collector<M> {
             self.finals.extend(chunk.finals);
             self.lasts += 1;
             if let (Some(e), None) = (&chunk.error, &failed) {
-                *failed = Some(TwError::Failed(e.clone()));
+                *failed = Some(ExecError::Failed(e.clone()));
             }
             self.settle(workers);
             return;
@@ -417,7 +409,7 @@ impl<M: Model> Collector<M> {
                 for o in c.output {
                     let states: &[M::State] = if self.shipped { &self.states } else { &[] };
                     if let Err(e) = sink(model, states, o) {
-                        *failed = Some(TwError::Sink(e));
+                        *failed = Some(ExecError::Sink(e));
                         break;
                     }
                 }
@@ -608,14 +600,14 @@ where
     /// Runs every batch with time at most `until` optimistically on the workers; the sink sees
     /// each output, with the committed states just after its batch, in the sequential order
     /// (on rank 0 only, under MPI).
-    pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), TwError<E>> {
+    pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), ExecError<E>> {
         if std::mem::take(&mut self.handed_over) {
             for w in &mut self.workers {
                 w.restore_states(&self.collector.states);
             }
         }
         let (tx, rx) = mpsc::channel();
-        let mut failed: Option<TwError<E>> = None;
+        let mut failed: Option<ExecError<E>> = None;
         self.collector.stats = TwStats::default();
         self.collector.pending = 0;
         self.collector.lasts = 0;
@@ -664,7 +656,7 @@ where
         rx: &mpsc::Receiver<ChunkOf<M>>,
         until: f64,
         sink: &mut Sink<'_, M, E>,
-        failed: &mut Option<TwError<E>>,
+        failed: &mut Option<ExecError<E>>,
     ) {
         let total = self.workers.len() * self.ranks;
         let workers_here = self.workers.len();
@@ -918,10 +910,10 @@ mod tests {
         let mut tw = TimeWarp::new(model, states, at(0.0), &worker_of, tw_cfg);
         let (tx, rx) = mpsc::channel();
         let liar = Liar(ThreadFabric::new(2, tx));
-        let mut failed: Option<TwError<()>> = None;
+        let mut failed: Option<ExecError<()>> = None;
         tw.drive(&liar, &rx, 30.0, &mut |_, _, _| Ok(()), &mut failed);
         match failed {
-            Some(TwError::Failed(m)) => assert!(m.contains("ran as final"), "{m}"),
+            Some(ExecError::Failed(m)) => assert!(m.contains("ran as final"), "{m}"),
             other => panic!("a lying fabric went unnoticed: {other:?}"),
         }
     }
