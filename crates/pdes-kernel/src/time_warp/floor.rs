@@ -47,7 +47,7 @@ impl Floor {
     }
 
     /// The place of the batch of object `to` at `time`, or just before it when its time's
-    /// tie-break is longer than [`DEPTH`] words.
+    /// tie-break is longer than [`TIE_WORDS`](crate::time::TIE_WORDS) words.
     pub fn of<T: Time>(time: &VTime<T>, to: u32) -> Floor {
         let mut f = Floor::start(time.t());
         let n = time.key.tie_words(&mut f.path);
