@@ -1,4 +1,4 @@
-//! `poolsim bench`: physical events per second and nanoseconds per event of the event-list engine
+//! The measurements of `poolsim bench`: physical events per second and nanoseconds per event of the event-list engine
 //! on the thesis gas, over ball counts and area fractions, with the machine's description; then
 //! the objects engine's cost over ball counts, Time Warp against the sequential objects engine
 //! on the sectored gas, and PHOLD's committed events per second.
@@ -10,73 +10,78 @@
 use crate::engine::event_list::{EventList, Options};
 use crate::engine::Ignore;
 use crate::scenario::builtin::{self, Params};
-use pdes_kernel::phold::ROSS_EVENTS_PER_SECOND_PER_CORE;
-use serde_json::json;
+use pdes_kernel::phold::{PholdConfig, PholdReport, ROSS_EVENTS_PER_SECOND_PER_CORE};
 use std::time::Instant;
 
-/// Arguments of `poolsim bench`.
-#[derive(clap::Args, Clone, Debug)]
-pub struct BenchArgs {
-    /// Ball counts (each rounded to a square number).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "1000,10000,100000,1000000"
-    )]
+/// What `poolsim bench` measures.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// Ball counts of the event-list rows (each rounded to a square number).
     pub balls: Vec<usize>,
-    /// Area fractions.
-    #[arg(
-        long = "area-fractions",
-        value_delimiter = ',',
-        default_value = "0.3,0.6"
-    )]
+    /// Area fractions of the event-list rows.
     pub area_fractions: Vec<f64>,
-    /// Physical events measured per configuration (at least 5 per ball are run).
-    #[arg(long, default_value_t = 2_000_000)]
+    /// Physical events measured per event-list row (at least 5 per ball are run).
     pub events: u64,
     /// Ball counts for the objects engine (non-sectored: its cost per event grows with N).
-    #[arg(
-        long = "objects-balls",
-        value_delimiter = ',',
-        default_value = "36,144,576"
-    )]
     pub objects_balls: Vec<usize>,
     /// Ball counts for the sectored objects engine (`--sectors auto`, area fraction 0.3).
-    #[arg(
-        long = "sectored-balls",
-        value_delimiter = ',',
-        default_value = "1024,4096"
-    )]
     pub sectored_balls: Vec<usize>,
-    /// Ball counts for Time Warp (on each of `--tw-workers`) against the sequential objects
-    /// engine: whole runs of the sectored gas (`--sectors auto`) until `--tw-until`, set-up
-    /// included.
-    #[arg(long = "tw-balls", value_delimiter = ',', default_value = "9801")]
+    /// Ball counts for Time Warp (on each of `tw_workers`) against the sequential objects
+    /// engine: whole runs of the sectored gas until `tw_until`, set-up included.
     pub tw_balls: Vec<usize>,
     /// Worker counts of the Time Warp and PHOLD rows.
-    #[arg(long = "tw-workers", value_delimiter = ',', default_value = "1,2")]
     pub tw_workers: Vec<usize>,
     /// Simulated time of the Time Warp runs.
-    #[arg(long = "tw-until", default_value_t = 1.0)]
     pub tw_until: f64,
     /// Pure Time Warp in the Time Warp and PHOLD runs: no batch runs as final.
-    #[arg(long = "tw-pure")]
     pub tw_pure: bool,
     /// PHOLD objects (16 messages each, remote 0.1, lookahead 0.1; as many partitions as the
-    /// most workers of `--tw-workers`, at least 2, in every row, so that every row runs one
-    /// model).
-    #[arg(long = "phold-objects", default_value_t = 1024)]
+    /// most workers of `tw_workers`, at least 2, in every row).
     pub phold_objects: u32,
     /// Grid cell width in ball diameters.
-    #[arg(long = "cell-diameters", default_value_t = 1.0)]
     pub cell_diameters: f64,
-    /// Runs of each configuration; the fastest is reported (for Time Warp, the repetition whose
-    /// three runs took least in all). Timings on a shared VM swing by tens of per cent.
-    #[arg(long, default_value_t = 1)]
+    /// Runs of each configuration; the fastest is reported.
     pub repeat: u32,
-    /// Print one JSON object instead of a table.
-    #[arg(long)]
-    pub json: bool,
+}
+
+/// Everything `poolsim bench` measured (its `--json` object).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BenchReport {
+    /// This machine ([`machine`]).
+    pub machine: String,
+    /// The engine of `rows`: `event-list`.
+    pub engine: &'static str,
+    /// The event-list rows.
+    pub rows: Vec<BenchRow>,
+    /// How their cost per event grows with the ball count.
+    pub growth: Vec<Growth>,
+    /// The plain objects engine's rows.
+    pub objects: Vec<ObjectsRow>,
+    /// The sectored objects engine's rows.
+    pub sectored: Vec<ObjectsRow>,
+    /// Time Warp against the sequential objects engine.
+    pub time_warp: Vec<TwRow>,
+    /// PHOLD on the sequential kernel, then on each worker count.
+    pub phold: Vec<PholdReport>,
+    /// ROSS's published PHOLD record per core, for comparison.
+    pub phold_ross_events_per_second_per_core: f64,
+}
+
+/// One result as soon as it is measured, for a caller that shows them as they come.
+#[derive(Clone, Copy, Debug)]
+pub enum Measured<'a> {
+    /// An event-list row.
+    Row(&'a BenchRow),
+    /// The event-list rows' growth, after the last of them.
+    Growth(&'a [Growth]),
+    /// A plain objects engine row.
+    Objects(&'a ObjectsRow),
+    /// A sectored objects engine row.
+    Sectored(&'a ObjectsRow),
+    /// A Time Warp row.
+    TimeWarp(&'a TwRow),
+    /// A PHOLD run.
+    Phold(&'a PholdReport),
 }
 
 /// The fastest of `n` (at least one) runs of `f`, by the seconds `secs` reads off each result.
@@ -276,8 +281,8 @@ pub fn measure(
     })
 }
 
-/// Runs `poolsim bench` and prints its table (or JSON).
-pub fn run(a: &BenchArgs) -> Result<(), String> {
+/// Checks the options; errors name the command line's flag.
+fn validate(a: &BenchOptions) -> Result<usize, String> {
     for &phi in &a.area_fractions {
         if !(phi > 0.0 && phi < 1.0) {
             return Err(format!(
@@ -324,14 +329,12 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             a.tw_until
         ));
     }
-    let m = machine();
-    if !a.json {
-        println!("event-list engine, thesis gas (seed 1), one thread; {m}");
-        println!(
-            "{:>9} {:>6} {:>11} {:>9} {:>9} {:>14} {:>9} {:>9}",
-            "balls", "phi", "events", "setup s", "loop s", "events/s", "ns/event", "RSS MiB"
-        );
-    }
+    Ok(partitions)
+}
+
+/// Measures everything `a` asks for, handing each result to `each` as soon as it is measured.
+pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchReport, String> {
+    let partitions = validate(a)?;
     let mut rows = Vec::new();
     for &n in &a.balls {
         for &phi in &a.area_fractions {
@@ -340,87 +343,30 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 |r: &BenchRow| r.seconds,
                 || measure(n, phi, a.events, a.cell_diameters),
             )?;
-            if !a.json {
-                println!(
-                    "{:>9} {:>6.2} {:>11} {:>9.2} {:>9.2} {:>14.0} {:>9.1} {:>9.0}",
-                    r.balls,
-                    r.area_fraction,
-                    r.events,
-                    r.setup_seconds,
-                    r.seconds,
-                    r.events_per_second,
-                    r.ns_per_event,
-                    r.rss_mib
-                );
-            }
+            each(Measured::Row(&r));
             rows.push(r);
         }
     }
     let growth = growth(&rows);
-    if !a.json {
-        for g in &growth {
-            println!(
-                "cost per event at {} balls / at {} balls, phi {:.2}: {:.2}",
-                g.to_balls, g.from_balls, g.area_fraction, g.ratio
-            );
-        }
-        println!();
-        println!("objects engine (thesis fig. 3, sequential, non-sectored), thesis gas until 4");
-        ObjectsRow::print_header();
-    }
-    let mut objects = Vec::new();
-    for &n in &a.objects_balls {
-        let r = fastest(
+    each(Measured::Growth(&growth));
+    let objects_row = |n: usize, sectors: Option<crate::run::SectorChoice>| {
+        fastest(
             a.repeat,
             |r: &ObjectsRow| r.seconds,
-            || measure_objects(n, None),
-        )?;
-        if !a.json {
-            r.print();
-        }
+            || measure_objects(n, sectors),
+        )
+    };
+    let mut objects = Vec::new();
+    for &n in &a.objects_balls {
+        let r = objects_row(n, None)?;
+        each(Measured::Objects(&r));
         objects.push(r);
-    }
-    if !a.json {
-        println!();
-        println!(
-            "sectored objects engine (thesis fig. 14, --sectors auto), gas at area fraction 0.3, \
-             t = {SECTORED_WARM_UP} to {} (after set-up and warm-up)",
-            SECTORED_WARM_UP + SECTORED_WINDOW
-        );
-        ObjectsRow::print_header();
     }
     let mut sectored = Vec::new();
     for &n in &a.sectored_balls {
-        let r = fastest(
-            a.repeat,
-            |r: &ObjectsRow| r.seconds,
-            || measure_objects(n, Some(crate::run::SectorChoice::Auto)),
-        )?;
-        if !a.json {
-            r.print();
-        }
+        let r = objects_row(n, Some(crate::run::SectorChoice::Auto))?;
+        each(Measured::Sectored(&r));
         sectored.push(r);
-    }
-    if !a.json {
-        println!();
-        println!(
-            "Time Warp against the sequential objects engine: sectored gas (--sectors auto) \
-             until {}, whole runs, each engine's fastest of {} run in turn (median: of the \
-             speed-ups within each turn)",
-            a.tw_until, a.repeat
-        );
-        println!(
-            "{:>9} {:>8} {:>9} {:>9} {:>9} {:>7} {:>11} {:>8} {:>6}  digest",
-            "balls",
-            "workers",
-            "wall s",
-            "set-up s",
-            "speed-up",
-            "median",
-            "efficiency",
-            "remote",
-            "final"
-        );
     }
     let mut time_warp = Vec::new();
     for &n in &a.tw_balls {
@@ -429,39 +375,41 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
             runs.push(measure_time_warp(n, a.tw_until, a.tw_pure, &a.tw_workers)?);
         }
         for r in fastest_rows(runs) {
-            if !a.json {
-                println!(
-                    "{:>9} {:>8} {:>9.3} {:>9.3} {:>9.2} {:>7.2} {:>11.3} {:>8.3} {:>6.3}  {}",
-                    r.balls,
-                    if r.workers == 0 {
-                        "seq".to_string()
-                    } else {
-                        r.workers.to_string()
-                    },
-                    r.seconds,
-                    r.setup_seconds,
-                    r.speedup,
-                    r.median_speedup,
-                    r.efficiency,
-                    r.remote_fraction,
-                    r.final_fraction,
-                    r.digest
-                );
-            }
+            each(Measured::TimeWarp(&r));
             time_warp.push(r);
         }
     }
-    // PHOLD: the sequential kernel, then Time Warp on each worker count, one model throughout
-    let phold_cfg = pdes_kernel::phold::PholdConfig {
+    let phold = measure_phold(a, partitions as u32, each)?;
+    Ok(BenchReport {
+        machine: machine(),
+        engine: "event-list",
+        rows,
+        growth,
+        objects,
+        sectored,
+        time_warp,
+        phold,
+        phold_ross_events_per_second_per_core: ROSS_EVENTS_PER_SECOND_PER_CORE,
+    })
+}
+
+/// PHOLD on the sequential kernel, then under Time Warp on each worker count, one model
+/// throughout; fails if a digest differs.
+fn measure_phold(
+    a: &BenchOptions,
+    partitions: u32,
+    each: &mut dyn FnMut(Measured),
+) -> Result<Vec<PholdReport>, String> {
+    let phold_cfg = PholdConfig {
         objects: a.phold_objects,
         events_per_object: 16,
         remote: 0.1,
-        partitions: partitions as u32,
+        partitions,
         lookahead: 0.1,
         mean: 1.0,
         seed: 1,
     };
-    let mut phold: Vec<pdes_kernel::phold::PholdReport> = Vec::new();
+    let mut phold: Vec<PholdReport> = Vec::new();
     for workers in std::iter::once(None).chain(a.tw_workers.iter().map(|&w| Some(w))) {
         let tw = workers.map(|w| pdes_kernel::time_warp::TwConfig {
             workers: w,
@@ -481,45 +429,10 @@ pub fn run(a: &BenchArgs) -> Result<(), String> {
                 first.final_state_digest
             ));
         }
+        each(Measured::Phold(&p));
         phold.push(p);
     }
-    if a.json {
-        println!(
-            "{}",
-            json!({"machine": m, "engine": "event-list", "rows": rows, "growth": growth,
-                   "objects": objects, "sectored": sectored, "time_warp": time_warp,
-                   "phold": phold,
-                   "phold_ross_events_per_second_per_core": ROSS_EVENTS_PER_SECOND_PER_CORE})
-        );
-    } else {
-        println!();
-        println!(
-            "PHOLD beside ROSS's published record, {:.2} M committed events/s per core (504 \
-             billion/s on 1,966,080 Blue Gene/Q cores; Barnes et al., PADS 2013):",
-            ROSS_EVENTS_PER_SECOND_PER_CORE / 1e6
-        );
-        for p in &phold {
-            let executor = match &p.time_warp {
-                Some(t) if t.workers == 1 => "1 worker".to_string(),
-                Some(t) => format!("{} workers", t.workers),
-                None => "sequential kernel".to_string(),
-            };
-            println!(
-                "PHOLD {} objects x 16 events, remote 0.1, {} partitions, end 20, {} ({}): {} \
-                 committed, {:.0} events/s, {:.2} M per core, efficiency {:.3}, digest {}",
-                p.objects,
-                p.partitions,
-                p.engine,
-                executor,
-                p.committed,
-                p.events_per_second,
-                p.events_per_second_per_core / 1e6,
-                p.time_warp.as_ref().map_or(1.0, |t| t.efficiency()),
-                p.final_state_digest
-            );
-        }
-    }
-    Ok(())
+    Ok(phold)
 }
 
 /// One measured run of the objects engine.
@@ -534,29 +447,6 @@ pub struct ObjectsRow {
     /// Wall seconds (set-up included for the plain engine; the measured window only for the
     /// sectored one).
     pub seconds: f64,
-}
-
-impl ObjectsRow {
-    fn print_header() {
-        println!(
-            "{:>9} {:>11} {:>12} {:>9} {:>14} {:>12} {:>10}",
-            "balls", "events", "messages", "wall s", "events/s", "messages/s", "msgs/event"
-        );
-    }
-
-    fn print(&self) {
-        let r = self;
-        println!(
-            "{:>9} {:>11} {:>12} {:>9.3} {:>14.0} {:>12.0} {:>10.1}",
-            r.balls,
-            r.events,
-            r.messages,
-            r.seconds,
-            r.events as f64 / r.seconds,
-            r.messages as f64 / r.seconds,
-            r.messages as f64 / r.events.max(1) as f64
-        );
-    }
 }
 
 /// Simulated time the sectored bench runs before it measures: set-up, the first trajectories

@@ -32,7 +32,6 @@ use serde::Serialize;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -51,8 +50,8 @@ const C_ENTRIES: f64 = 3.0;
 /// The thesis' "number of adjacent objects" per sector (6.1, ch. 7).
 const THESIS_ADJACENT: f64 = 4.0;
 
-/// Which experiment `poolsim experiment` runs.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+/// Which experiment to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Which {
     /// Thesis chapter 6 (tables 5-10) with the chapter 7 model (figures 17-18).
     Thesis,
@@ -60,32 +59,43 @@ pub enum Which {
     Reversal,
 }
 
-/// Arguments of `poolsim experiment`.
-#[derive(clap::Args, Clone, Debug)]
-pub struct ExperimentArgs {
-    /// The experiment: `thesis` (chapter 6 tables 5-10 and chapter 7 figures 17-18).
-    #[arg(value_enum)]
+/// What `poolsim experiment` was asked for; options left `None` take the plan's defaults.
+#[derive(Clone, Debug)]
+pub struct ExperimentOptions {
+    /// The experiment.
     pub which: Which,
-    /// Directory to write the tables, figures, results.json and report.md into (created if
+    /// Directory to write the tables, figures, `results.json` and `report.md` into (created if
     /// missing; files already there are overwritten).
-    #[arg(long)]
     pub out: PathBuf,
-    /// Seeds per cell, 1..=S (default 6, as the thesis ran its non-sectored cases; 2 with --quick).
-    #[arg(long)]
+    /// Seeds per cell, 1..=S (default 6, as the thesis ran its non-sectored cases; 2 when quick).
     pub seeds: Option<u64>,
-    /// Numbers of balls, comma separated square numbers (default 4,16,36,64; 4,16 with --quick).
-    #[arg(long, value_delimiter = ',')]
+    /// Numbers of balls, square numbers (default 4, 16, 36, 64; 4, 16 when quick).
     pub balls: Option<Vec<usize>>,
     /// A reduced grid for CI: 4 and 16 balls, 2 seeds, until 4.
-    #[arg(long)]
     pub quick: bool,
-    /// TrueType font for the figures' text (default: DejaVu Sans from Debian's
-    /// fonts-dejavu-core).
-    #[arg(long)]
+    /// TrueType font for the figures' text (default [`DEFAULT_FONT`]).
     pub font: Option<PathBuf>,
 }
 
-/// What one invocation runs: resolved from [`ExperimentArgs`].
+/// How far the experiment has come, for a progress display.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Progress {
+    /// The runs are about to start; there are this many.
+    Start(u64),
+    /// The runs of `balls` balls with this seed are under way.
+    Cell {
+        /// Balls.
+        balls: usize,
+        /// Seed.
+        seed: u64,
+    },
+    /// One more run is done.
+    RunDone,
+    /// Every run is done.
+    Finished,
+}
+
+/// What one invocation runs: resolved from [`ExperimentOptions`].
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Plan {
     /// Numbers of balls, each a square, ascending.
@@ -103,7 +113,7 @@ pub struct Plan {
 impl Plan {
     /// The plan the arguments ask for: `--quick` changes the defaults, explicit `--seeds` and
     /// `--balls` win over them. Errors name the option.
-    pub fn from_args(a: &ExperimentArgs) -> Result<Plan, String> {
+    pub fn from_options(a: &ExperimentOptions) -> Result<Plan, String> {
         let seeds = a.seeds.unwrap_or(if a.quick { 2 } else { 6 });
         if seeds == 0 || seeds > 1000 {
             return Err(format!("--seeds must be from 1 to 1000, got {seeds}"));
@@ -650,27 +660,15 @@ impl Data {
     }
 }
 
-/// Runs every cell of the plan, with a progress bar on stderr when it is a terminal.
-fn measure(plan: &Plan) -> Result<Data, String> {
+/// Runs every cell of the plan, telling `progress` how far it has come.
+fn measure(plan: &Plan, progress: &mut dyn FnMut(Progress)) -> Result<Data, String> {
     let start = Instant::now();
     let total: u64 = plan
         .balls
         .iter()
         .map(|&n| (settings(n).len() as u64 + 1) * plan.seeds)
         .sum();
-    let bar = if std::io::stderr().is_terminal() {
-        let b = indicatif::ProgressBar::new(total);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} experiment thesis [{bar:40}] {pos}/{len} runs {msg}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        b
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    progress(Progress::Start(total));
     let mut runs = Vec::new();
     let mut physics_runs = Vec::new();
     let mut cells: BTreeMap<(usize, Setting), Vec<usize>> = BTreeMap::new();
@@ -678,9 +676,9 @@ fn measure(plan: &Plan) -> Result<Data, String> {
     for &n in &plan.balls {
         for seed in 1..=plan.seeds {
             let s = gas(n, seed)?;
-            bar.set_message(format!("{n} balls, seed {seed}"));
+            progress(Progress::Cell { balls: n, seed });
             let ph = physics(&s, n, seed, plan.until)?;
-            bar.inc(1);
+            progress(Progress::RunDone);
             for setting in settings(n) {
                 let r = objects(&s, n, seed, setting, plan.until, plan.timing_repeats)?;
                 if r.digest != ph.digest {
@@ -694,12 +692,12 @@ fn measure(plan: &Plan) -> Result<Data, String> {
                 }
                 cells.entry((n, setting)).or_default().push(runs.len());
                 runs.push(r);
-                bar.inc(1);
+                progress(Progress::RunDone);
             }
             physics_runs.push(ph);
         }
     }
-    bar.finish_and_clear();
+    progress(Progress::Finished);
     Ok(Data {
         plan: plan.clone(),
         runs,
@@ -2848,7 +2846,7 @@ fn results_json(data: &Data, fs: &[Finding]) -> Value {
 /// Runs `poolsim experiment`: every run of the plan, then the tables, `results.json` and the
 /// report, then the figures. Errors are one line for the user (bad arguments, a failed run, an
 /// unwritable directory, a missing font); files written before an error stay.
-pub fn run(args: &ExperimentArgs) -> Result<(), String> {
+pub fn run(args: &ExperimentOptions, progress: &mut dyn FnMut(Progress)) -> Result<(), String> {
     if args.which == Which::Reversal {
         if let Some(flag) = [
             ("--seeds", args.seeds.is_some()),
@@ -2868,10 +2866,10 @@ pub fn run(args: &ExperimentArgs) -> Result<(), String> {
             .unwrap_or_else(|| PathBuf::from(DEFAULT_FONT));
         return crate::reversal_study::run(&args.out, &font, args.quick);
     }
-    let plan = Plan::from_args(args)?;
+    let plan = Plan::from_options(args)?;
     let dir = &args.out;
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let data = measure(&plan)?;
+    let data = measure(&plan, progress)?;
     let tables = vec![
         ("table5", table5(&data)),
         ("table6", table6(&data)),
@@ -2951,7 +2949,7 @@ mod tests {
 
     #[test]
     fn plan_defaults_and_errors() {
-        let mut a = ExperimentArgs {
+        let mut a = ExperimentOptions {
             which: Which::Thesis,
             out: PathBuf::from("x"),
             seeds: None,
@@ -2959,15 +2957,15 @@ mod tests {
             quick: false,
             font: None,
         };
-        let p = Plan::from_args(&a).unwrap();
+        let p = Plan::from_options(&a).unwrap();
         assert_eq!((p.balls.clone(), p.seeds), (vec![4, 16, 36, 64], 6));
         a.quick = true;
-        let p = Plan::from_args(&a).unwrap();
+        let p = Plan::from_options(&a).unwrap();
         assert_eq!((p.balls, p.seeds, p.until), (vec![4, 16], 2, 4.0));
         a.balls = Some(vec![10]);
-        assert!(Plan::from_args(&a).unwrap_err().contains("--balls"));
+        assert!(Plan::from_options(&a).unwrap_err().contains("--balls"));
         a.balls = None;
         a.seeds = Some(0);
-        assert!(Plan::from_args(&a).unwrap_err().contains("--seeds"));
+        assert!(Plan::from_options(&a).unwrap_err().contains("--seeds"));
     }
 }

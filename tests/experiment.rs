@@ -2,7 +2,7 @@
 //! thesis' numbers beside ours, and the figures are real SVG and PNG files. Only what the data
 //! show robustly across seeds is asserted; nothing about timing.
 
-use poolsim::experiment::{run, ExperimentArgs, Which};
+use poolsim::experiment::{run, ExperimentOptions, Which};
 use serde_json::Value;
 use std::path::Path;
 
@@ -22,7 +22,7 @@ const FILES: [&str; 12] = [
 ];
 
 fn quick(dir: &Path) {
-    let args = ExperimentArgs {
+    let args = ExperimentOptions {
         which: Which::Thesis,
         out: dir.to_path_buf(),
         seeds: None,
@@ -30,7 +30,7 @@ fn quick(dir: &Path) {
         quick: true,
         font: None,
     };
-    run(&args).expect("the quick experiment runs");
+    run(&args, &mut |_| {}).expect("the quick experiment runs");
 }
 
 /// Mean total messages of one cell from results.json.
@@ -142,7 +142,7 @@ fn quick_experiment_writes_tables_figures_and_report() {
 #[test]
 fn a_missing_font_is_a_clear_error_after_the_tables() {
     let dir = tempfile::tempdir().unwrap();
-    let args = ExperimentArgs {
+    let args = ExperimentOptions {
         which: Which::Thesis,
         out: dir.path().to_path_buf(),
         seeds: Some(1),
@@ -150,7 +150,7 @@ fn a_missing_font_is_a_clear_error_after_the_tables() {
         quick: true,
         font: Some(dir.path().join("no-such-font.ttf")),
     };
-    let err = run(&args).unwrap_err();
+    let err = run(&args, &mut |_| {}).unwrap_err();
     assert!(
         err.contains("no-such-font.ttf") && err.contains("fonts-dejavu-core"),
         "{err}"
@@ -162,7 +162,7 @@ fn a_missing_font_is_a_clear_error_after_the_tables() {
 #[test]
 fn bad_arguments_name_the_option() {
     let dir = tempfile::tempdir().unwrap();
-    let mut args = ExperimentArgs {
+    let mut args = ExperimentOptions {
         which: Which::Thesis,
         out: dir.path().to_path_buf(),
         seeds: None,
@@ -170,8 +170,8 @@ fn bad_arguments_name_the_option() {
         quick: true,
         font: None,
     };
-    assert!(run(&args).unwrap_err().contains("--balls"));
+    assert!(run(&args, &mut |_| {}).unwrap_err().contains("--balls"));
     args.balls = None;
     args.seeds = Some(0);
-    assert!(run(&args).unwrap_err().contains("--seeds"));
+    assert!(run(&args, &mut |_| {}).unwrap_err().contains("--seeds"));
 }

@@ -1,0 +1,168 @@
+//! What several commands share: generator options, loading a scenario, failures and their exit
+//! statuses, the progress line, Time Warp's worker count, MPI start-up.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use pdes_kernel::time_warp::TwConfig;
+use poolsim::engine::{Event, Observer, RunError, World};
+use poolsim::scenario::{self, builtin, Scenario};
+use std::io::IsTerminal;
+
+/// Parameters of generated scenarios.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct GenArgs {
+    /// Number of balls (gas: a square number).
+    #[arg(long)]
+    pub balls: Option<usize>,
+    /// Random seed of generated scenarios.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Fraction of the table's area covered by balls (gas).
+    #[arg(long = "area-fraction")]
+    pub area_fraction: Option<f64>,
+    /// Ball radius (gas).
+    #[arg(long)]
+    pub radius: Option<f64>,
+    /// Speeds are drawn uniform in [0, V) (gas, reversal).
+    #[arg(long = "speed-max")]
+    pub speed_max: Option<f64>,
+}
+
+impl GenArgs {
+    fn params(&self) -> builtin::Params {
+        builtin::Params {
+            balls: self.balls,
+            seed: self.seed,
+            area_fraction: self.area_fraction,
+            radius: self.radius,
+            speed_max: self.speed_max,
+        }
+    }
+}
+
+/// A failure with its exit status.
+pub struct Failure {
+    pub code: u8,
+    pub message: String,
+}
+
+pub fn usage(message: impl Into<String>) -> Failure {
+    Failure {
+        code: 2,
+        message: message.into(),
+    }
+}
+
+pub fn internal(message: impl Into<String>) -> Failure {
+    Failure {
+        code: 1,
+        message: message.into(),
+    }
+}
+
+/// Shows progress in simulated time on stderr.
+pub struct Progress {
+    pub bar: ProgressBar,
+    pub until: f64,
+    pub seen: u64,
+}
+
+impl Progress {
+    pub fn new(until: f64, quiet: bool) -> Option<Progress> {
+        if quiet || !std::io::stderr().is_terminal() || until.is_nan() || until <= 0.0 {
+            return None;
+        }
+        let bar = ProgressBar::new(1000);
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}")
+                .expect("a valid template"),
+        );
+        // the spinner and clock move even before the first event: setting up a large sectored
+        // table takes a while
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        bar.set_message(format!("t = 0 / {until}, 0 events"));
+        Some(Progress {
+            bar,
+            until,
+            seen: 0,
+        })
+    }
+}
+
+impl Observer for Progress {
+    fn on_event(&mut self, ev: &Event, _: &dyn World) -> Result<(), RunError> {
+        self.seen += 1;
+        if self.seen.is_multiple_of(8192) {
+            self.bar
+                .set_position((ev.t / self.until * 1000.0).clamp(0.0, 1000.0) as u64);
+            self.bar.set_message(format!(
+                "t = {:.3} / {}, {} events",
+                ev.t, self.until, self.seen
+            ));
+        }
+        Ok(())
+    }
+
+    fn reads_balls(&self) -> bool {
+        false
+    }
+}
+
+pub fn load(spec: &str, gen: &GenArgs) -> Result<Scenario, Failure> {
+    scenario::load(spec, &gen.params()).map_err(|e| usage(e.to_string()))
+}
+
+/// A run's failure: bad input (exit 2) or the run's own (exit 1).
+pub fn run_failure(e: RunError) -> Failure {
+    match e {
+        RunError::Input(m) => usage(m),
+        e => internal(e.to_string()),
+    }
+}
+
+/// MPI, when this process was started by `mpirun` (cargo feature `mpi`), held for the run.
+#[cfg(feature = "mpi")]
+pub fn start_mpi() -> Result<Option<mpi::environment::Universe>, Failure> {
+    let launched = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some());
+    if !launched {
+        return Ok(None);
+    }
+    use mpi::Threading;
+    match mpi::initialize_with_threading(Threading::Serialized) {
+        Some((u, Threading::Serialized | Threading::Multiple)) => Ok(Some(u)),
+        Some(_) => Err(internal(
+            "MPI: the library cannot serve calls from several threads (MPI_THREAD_SERIALIZED)",
+        )),
+        None => Err(internal("MPI: initialization failed")),
+    }
+}
+
+/// Time Warp's default settings with `--workers` (default: this machine's cores) and
+/// `POOLSIM_CHAOS`.
+pub fn tw_workers(workers: Option<usize>) -> Result<TwConfig, Failure> {
+    let mut tw = TwConfig {
+        workers: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        chaos: chaos_from_env().map_err(usage)?,
+        ..TwConfig::default()
+    };
+    if let Some(w) = workers {
+        if !(1..=1024).contains(&w) {
+            return Err(usage(format!("--workers: must be 1 to 1024, got {w}")));
+        }
+        tw.workers = w;
+    }
+    Ok(tw)
+}
+
+/// Seeds for chaos mode from `POOLSIM_CHAOS`, when set to a number.
+pub fn chaos_from_env() -> Result<Option<u64>, String> {
+    match std::env::var("POOLSIM_CHAOS") {
+        Err(_) => Ok(None),
+        Ok(s) if s.is_empty() => Ok(None),
+        Ok(s) => s
+            .parse()
+            .map(Some)
+            .map_err(|_| format!("POOLSIM_CHAOS: expected a seed (an integer), got `{s}`")),
+    }
+}

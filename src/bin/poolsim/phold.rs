@@ -1,0 +1,161 @@
+//! `poolsim phold`: PHOLD, the standard PDES benchmark, on the kernel.
+
+use crate::common::*;
+
+/// Arguments of `poolsim phold`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct PholdArgs {
+    /// Number of objects.
+    #[arg(long, default_value_t = 1024)]
+    pub objects: u32,
+    /// Messages each object starts with.
+    #[arg(long = "events-per-object", default_value_t = 16)]
+    pub events_per_object: u32,
+    /// Probability that a message goes to another partition.
+    #[arg(long, default_value_t = 0.1)]
+    pub remote: f64,
+    /// Partitions; objects are split in equal blocks (default: the Time Warp workers of all
+    /// ranks, or 2 on the sequential kernel).
+    #[arg(long)]
+    pub partitions: Option<u32>,
+    /// objects (the sequential kernel) or time-warp.
+    #[arg(long, default_value = "objects")]
+    pub engine: String,
+    /// Time Warp workers per rank (default: this machine's cores).
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// End time.
+    #[arg(long, default_value_t = 100.0)]
+    pub end: f64,
+    /// Minimum delay of a message.
+    #[arg(long, default_value_t = 0.1)]
+    pub lookahead: f64,
+    /// Mean of the exponential part of the delay.
+    #[arg(long, default_value_t = 1.0)]
+    pub mean: f64,
+    /// Seed of the objects' random streams.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The most PHOLD events in flight (objects times events per object): about a gigabyte.
+pub const MAX_PHOLD_EVENTS: u64 = 10_000_000;
+
+pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
+    use pdes_kernel::phold::{run, PholdConfig};
+    let positive = |flag: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(usage(format!("{flag}: must be a positive number, got {v}")))
+        }
+    };
+    positive("--end", a.end)?;
+    positive("--mean", a.mean)?;
+    if !(a.lookahead.is_finite() && a.lookahead >= 0.0) {
+        return Err(usage(format!(
+            "--lookahead: must not be negative, got {}",
+            a.lookahead
+        )));
+    }
+    if !(0.0..=1.0).contains(&a.remote) {
+        return Err(usage(format!(
+            "--remote: must lie in [0, 1], got {}",
+            a.remote
+        )));
+    }
+    let tw = match a.engine.as_str() {
+        "objects" => {
+            if a.workers.is_some() {
+                return Err(usage("--workers: only the time-warp engine takes it"));
+            }
+            None
+        }
+        "time-warp" => Some(tw_workers(a.workers)?),
+        other => {
+            return Err(usage(format!(
+                "--engine: PHOLD runs on objects or time-warp, not `{other}`"
+            )))
+        }
+    };
+    if tw.is_some() {
+        poolsim::memory::transparent_huge_pages(false);
+    }
+    #[cfg(feature = "mpi")]
+    let _mpi = if tw.is_some() { start_mpi()? } else { None };
+    let partitions = a.partitions.unwrap_or_else(|| match &tw {
+        Some(c) => pdes_kernel::time_warp::threads::total_workers(c) as u32,
+        None => 2,
+    });
+    if u64::from(a.objects) * u64::from(a.events_per_object) > MAX_PHOLD_EVENTS {
+        return Err(usage(format!(
+            "--objects x --events-per-object: at most {MAX_PHOLD_EVENTS} events in flight, got \
+             {} x {}",
+            a.objects, a.events_per_object
+        )));
+    }
+    if a.objects == 0 || partitions == 0 || partitions > a.objects {
+        return Err(usage(format!(
+            "--objects and --partitions: need 1 <= partitions <= objects, got {} and {}",
+            partitions, a.objects
+        )));
+    }
+    let report = run(
+        PholdConfig {
+            objects: a.objects,
+            events_per_object: a.events_per_object,
+            remote: a.remote,
+            partitions,
+            lookahead: a.lookahead,
+            mean: a.mean,
+            seed: a.seed,
+        },
+        a.end,
+        tw,
+    )
+    .map_err(internal)?;
+    if pdes_kernel::time_warp::threads::place().0 != 0 {
+        return Ok(());
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&report).expect("a report serializes")
+        );
+    } else {
+        println!(
+            "PHOLD on {}, {} objects x {} events, remote {}, {} partitions, end {}: {} committed \
+             events in {:.3} s, {:.0} events/s ({:.2} M per core; ROSS's published record: \
+             {:.2} M per core), digest {}",
+            report.engine,
+            report.objects,
+            report.events_per_object,
+            report.remote,
+            report.partitions,
+            report.end,
+            report.committed,
+            report.wall_seconds,
+            report.events_per_second,
+            report.events_per_second_per_core / 1e6,
+            pdes_kernel::phold::ROSS_EVENTS_PER_SECOND_PER_CORE / 1e6,
+            report.final_state_digest
+        );
+        if let Some(t) = &report.time_warp {
+            println!(
+                "time warp: {} workers on {} ranks, processed {}, committed {}, efficiency {:.3}, \
+                 {} rollbacks, {} GVT rounds",
+                t.workers,
+                t.ranks,
+                t.processed,
+                t.committed,
+                t.efficiency(),
+                t.rollbacks,
+                t.gvt_rounds
+            );
+        }
+    }
+    Ok(())
+}

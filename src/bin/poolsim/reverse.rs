@@ -1,0 +1,91 @@
+//! `poolsim reverse`: the reversal experiment (thesis 4.6-4.7).
+
+use crate::common::*;
+use crate::run::*;
+
+/// Arguments of `poolsim reverse`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct ReverseArgs {
+    /// A built-in scenario name or a TOML file; its balls are placed at time -Q.
+    pub scenario: String,
+    /// Quitting time Q.
+    #[arg(long, allow_negative_numbers = true)]
+    pub quit: f64,
+    /// event-list, time-step, objects or time-warp.
+    #[arg(long, default_value = "event-list")]
+    pub engine: String,
+    /// Sector layout of the objects engines: none, auto, N or NxM.
+    #[arg(long)]
+    pub sectors: Option<String>,
+    #[command(flatten)]
+    pub gen: GenArgs,
+    /// Time step of the time-step engine.
+    #[arg(long, allow_negative_numbers = true)]
+    pub dt: Option<f64>,
+    /// Delay of NewVelocity messages (objects engine).
+    #[arg(long = "newvelocity-delay")]
+    pub newvelocity_delay: Option<String>,
+    /// Check invariants at every event.
+    #[arg(long)]
+    pub check: bool,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
+    if !(a.quit.is_finite() && a.quit > 0.0) {
+        return Err(usage(format!(
+            "--quit: must be a positive number, got {}",
+            a.quit
+        )));
+    }
+    let scenario = load(&a.scenario, &a.gen)?;
+    let run_args = RunArgs {
+        scenario: a.scenario.clone(),
+        engine: a.engine.clone(),
+        sectors: a.sectors.clone(),
+        until: None,
+        gen: a.gen.clone(),
+        trace: None,
+        final_state: None,
+        json: a.json,
+        check: a.check,
+        workers: None,
+        tw_window: None,
+        tw_memory: None,
+        gvt_interval: None,
+        tw_pure: false,
+        newvelocity_delay: a.newvelocity_delay.clone(),
+        fixed_news: None,
+        dt: a.dt,
+        quiet: true,
+    };
+    let engine = engine_of(&run_args, &scenario)?;
+    let r = poolsim::run::reverse(&scenario, engine, a.quit, a.check).map_err(run_failure)?;
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&r).expect("a report serializes")
+        );
+    } else {
+        println!(
+            "{} on {}: -{} to {}, {} events ({} before the reversal); largest error: position \
+             {:e}, velocity {:e}{}",
+            r.scenario,
+            r.engine,
+            r.quit,
+            r.quit,
+            r.events,
+            r.forward_events,
+            r.max_position_error,
+            r.max_velocity_error,
+            if r.still_pocketed > 0 {
+                format!("; {} balls still in pockets", r.still_pocketed)
+            } else {
+                String::new()
+            }
+        );
+    }
+    Ok(())
+}

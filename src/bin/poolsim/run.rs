@@ -1,0 +1,481 @@
+//! `poolsim run`: one scenario on one engine, with its trace, final state and summary.
+
+use crate::common::*;
+use pdes_kernel::time_warp::TwConfig;
+use poolsim::engine::{Event, Observer, RunError, World};
+use poolsim::model::pool::NvDelay;
+use poolsim::output::{FinalState, TraceWriter};
+use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
+use poolsim::scenario::{self, Scenario};
+use poolsim::summary::RunSummary;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::PathBuf;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct RunArgs {
+    /// A built-in scenario name (see `poolsim scenarios`) or a TOML file.
+    pub scenario: String,
+    /// event-list, time-step, objects or time-warp.
+    #[arg(long, default_value = "event-list")]
+    pub engine: String,
+    /// Sector layout: none, auto, N or NxM (sectored engines only).
+    #[arg(long)]
+    pub sectors: Option<String>,
+    /// End time (default: the scenario's).
+    #[arg(long, allow_negative_numbers = true)]
+    pub until: Option<f64>,
+    #[command(flatten)]
+    pub gen: GenArgs,
+    /// Write the trace (JSON Lines, one line per physical event) here.
+    #[arg(long)]
+    pub trace: Option<PathBuf>,
+    /// Write the final state (JSON) here.
+    #[arg(long = "final-state")]
+    pub final_state: Option<PathBuf>,
+    /// Print the run summary as one JSON object on stdout, and nothing else there.
+    #[arg(long)]
+    pub json: bool,
+    /// Check invariants at every event; a violation stops the run with exit status 1.
+    #[arg(long)]
+    pub check: bool,
+    /// Worker threads (time-warp engine; default: this machine's cores).
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// Time Warp's optimism window: no batch later than GVT plus this (simulation time).
+    #[arg(long = "tw-window", allow_negative_numbers = true)]
+    pub tw_window: Option<f64>,
+    /// Time Warp's memory budget: uncommitted batches per worker.
+    #[arg(long = "tw-memory")]
+    pub tw_memory: Option<usize>,
+    /// Batches a Time Warp worker runs between GVT rounds (default 2048 on threads, 256
+    /// across MPI ranks).
+    #[arg(long = "gvt-interval")]
+    pub gvt_interval: Option<u32>,
+    /// Pure Time Warp: every batch runs optimistically, with its state saved, even one that
+    /// nothing can roll back any more (by default such a batch runs as final).
+    #[arg(long = "tw-pure")]
+    pub tw_pure: bool,
+    /// Delay of NewVelocity messages (objects engines).
+    #[arg(long = "newvelocity-delay")]
+    pub newvelocity_delay: Option<String>,
+    /// Which balls tell cushions, pockets and corners of a new trajectory on a sectored table:
+    /// near (those in sectors within reach; the default) or thesis (all: fig. 15's counts).
+    #[arg(long = "fixed-news")]
+    pub fixed_news: Option<String>,
+    /// Time step of the time-step engine.
+    #[arg(long, allow_negative_numbers = true)]
+    pub dt: Option<f64>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// `--fixed-news`: near (the default) or thesis.
+pub fn fixed_news(arg: Option<&str>) -> Result<FixedNews, Failure> {
+    match arg {
+        None | Some("near") => Ok(FixedNews::Near),
+        Some("thesis") => Ok(FixedNews::Thesis),
+        Some(other) => Err(usage(format!(
+            "--fixed-news: expected near or thesis, got `{other}`"
+        ))),
+    }
+}
+
+/// `--newvelocity-delay`: absent or 0 is exact; `auto` is the thesis' choice (4.4): a ball at the
+/// fastest initial speed moves 1% of the smallest diameter in the delay.
+pub fn nv_delay(arg: Option<&str>, s: &Scenario) -> Result<NvDelay, Failure> {
+    let d = match arg {
+        None => return Ok(NvDelay::Exact),
+        Some("auto") => {
+            let vmax = s
+                .balls
+                .iter()
+                .map(|b| b.velocity.norm())
+                .fold(0.0, f64::max);
+            let dmin = s
+                .balls
+                .iter()
+                .map(|b| 2.0 * b.radius)
+                .fold(f64::INFINITY, f64::min);
+            if vmax > 0.0 && dmin.is_finite() {
+                0.01 * dmin / vmax
+            } else {
+                0.0
+            }
+        }
+        Some(text) => text.parse::<f64>().map_err(|_| {
+            usage(format!(
+                "--newvelocity-delay: expected a number or `auto`, got `{text}`"
+            ))
+        })?,
+    };
+    if !d.is_finite() || d < 0.0 {
+        return Err(usage(format!(
+            "--newvelocity-delay: must be a finite number not below 0, got {d}"
+        )));
+    }
+    Ok(if d == 0.0 {
+        NvDelay::Exact
+    } else {
+        NvDelay::Delay(d)
+    })
+}
+
+/// `--sectors`: none, auto, N (N x N) or NxM; absent means the scenario's own `[sectors]`, if
+/// any.
+pub fn sector_choice(arg: Option<&str>, s: &Scenario) -> Result<Option<SectorChoice>, Failure> {
+    let bad = || {
+        usage(format!(
+            "--sectors: expected none, auto, N or NxM (sectors per side, at least 1 each, at most \
+             {} sectors in all), got `{}`",
+            scenario::MAX_SECTORS,
+            arg.unwrap_or_default()
+        ))
+    };
+    let count = |text: &str| match text.parse::<u32>() {
+        Ok(n) if n >= 1 && u64::from(n) <= scenario::MAX_SECTORS => Ok(n),
+        _ => Err(bad()),
+    };
+    let grid = |nx: u32, ny: u32| {
+        if u64::from(nx) * u64::from(ny) > scenario::MAX_SECTORS {
+            Err(bad())
+        } else {
+            Ok(Some(SectorChoice::Grid(nx, ny)))
+        }
+    };
+    Ok(match arg {
+        None => s.sectors.as_ref().map(|_| SectorChoice::Scenario),
+        Some("none") => None,
+        Some("auto") => Some(SectorChoice::Auto),
+        Some(text) => match text.split_once(['x', 'X']) {
+            Some((nx, ny)) => grid(count(nx)?, count(ny)?)?,
+            None => {
+                let n = count(text)?;
+                grid(n, n)?
+            }
+        },
+    })
+}
+
+pub fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
+    match a.engine.as_str() {
+        "event-list" => {
+            if let Some(flag) = a.dt.map(|_| "--dt") {
+                return Err(usage(format!("{flag}: only the time-step engine takes it")));
+            }
+            Ok(EngineKind::EventList)
+        }
+        "time-step" => {
+            let dt =
+                a.dt.ok_or_else(|| usage("--dt: the time-step engine needs a time step"))?;
+            if !(dt.is_finite() && dt > 0.0) {
+                return Err(usage(format!("--dt: must be a positive number, got {dt}")));
+            }
+            Ok(EngineKind::TimeStep { dt })
+        }
+        "objects" => {
+            let delay = nv_delay(a.newvelocity_delay.as_deref(), scenario)?;
+            match sector_choice(a.sectors.as_deref(), scenario)? {
+                None => Ok(EngineKind::Objects { delay }),
+                Some(_) if delay != NvDelay::Exact => Err(usage(
+                    "--newvelocity-delay: the thesis' delay runs on non-sectored tables only \
+                     (--sectors none)",
+                )),
+                Some(sectors) => {
+                    poolsim::run::sector_layout(scenario, sectors)
+                        .map_err(|e| usage(format!("--sectors: {e}")))?;
+                    Ok(EngineKind::Sectored {
+                        sectors,
+                        news: fixed_news(a.fixed_news.as_deref())?,
+                    })
+                }
+            }
+        }
+        "time-warp" => {
+            let delay = nv_delay(a.newvelocity_delay.as_deref(), scenario)?;
+            let sectors = sector_choice(a.sectors.as_deref(), scenario)?;
+            if let Some(choice) = sectors {
+                if delay != NvDelay::Exact {
+                    return Err(usage(
+                        "--newvelocity-delay: the thesis' delay runs on non-sectored tables \
+                         only (--sectors none)",
+                    ));
+                }
+                poolsim::run::sector_layout(scenario, choice)
+                    .map_err(|e| usage(format!("--sectors: {e}")))?;
+            }
+            Ok(EngineKind::TimeWarp {
+                tw: tw_config(a)?,
+                delay,
+                sectors,
+                news: fixed_news(a.fixed_news.as_deref())?,
+            })
+        }
+        other => Err(usage(format!(
+            "--engine: unknown engine `{other}`; available: event-list, time-step, objects, \
+             time-warp"
+        ))),
+    }
+}
+
+/// Time Warp's settings from the flags and `POOLSIM_CHAOS`.
+pub fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
+    let mut tw = tw_workers(a.workers)?;
+    if let Some(w) = a.tw_window {
+        if !(w.is_finite() && w > 0.0) {
+            return Err(usage(format!(
+                "--tw-window: must be a positive number, got {w}"
+            )));
+        }
+        tw.window = Some(w);
+    }
+    if let Some(m) = a.tw_memory {
+        if m < 16 {
+            return Err(usage(format!(
+                "--tw-memory: must be at least 16 batches, got {m}"
+            )));
+        }
+        tw.max_uncommitted = m;
+    }
+    if let Some(g) = a.gvt_interval {
+        if g == 0 {
+            return Err(usage("--gvt-interval: must be at least 1"));
+        }
+        tw.gvt_interval = Some(g);
+    }
+    tw.final_batches = !a.tw_pure;
+    Ok(tw)
+}
+
+/// The trace and the final state must go to two files, neither of them the scenario: writing
+/// one would truncate the other.
+pub fn check_outputs_apart(a: &RunArgs) -> Result<(), Failure> {
+    // where a path points, resolved as far as it exists; devices such as /dev/null are shared
+    let resolved = |p: &std::path::Path| {
+        if p.exists() && !p.is_file() {
+            return None;
+        }
+        p.canonicalize().ok().or_else(|| {
+            let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+            let dir = dir.unwrap_or(std::path::Path::new("."));
+            Some(dir.canonicalize().ok()?.join(p.file_name()?))
+        })
+    };
+    let same = |x: &std::path::Path, y: &std::path::Path| {
+        resolved(x).is_some_and(|x| resolved(y) == Some(x))
+    };
+    let scenario = std::path::Path::new(&a.scenario);
+    for (flag, out) in [("--trace", &a.trace), ("--final-state", &a.final_state)] {
+        if let Some(out) = out {
+            if same(out, scenario) {
+                return Err(usage(format!(
+                    "{flag}: {} is the scenario file; writing it would destroy it",
+                    out.display()
+                )));
+            }
+        }
+    }
+    if let (Some(t), Some(f)) = (&a.trace, &a.final_state) {
+        if same(t, f) {
+            return Err(usage(format!(
+                "--trace and --final-state: both name {}; give two files",
+                t.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+pub fn run(a: &RunArgs) -> Result<(), Failure> {
+    let scenario = load(&a.scenario, &a.gen)?;
+    let engine = engine_of(a, &scenario)?;
+    let objects = matches!(
+        engine,
+        EngineKind::Objects { .. } | EngineKind::Sectored { .. } | EngineKind::TimeWarp { .. }
+    );
+    let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
+    if objects {
+        poolsim::memory::transparent_huge_pages(false);
+    }
+    let sectored = matches!(
+        engine,
+        EngineKind::Sectored { .. }
+            | EngineKind::TimeWarp {
+                sectors: Some(_),
+                ..
+            }
+    );
+    if a.fixed_news.is_some() && !sectored {
+        return Err(usage(
+            "--fixed-news: only sectored runs take it (--engine objects or time-warp with --sectors)",
+        ));
+    }
+    for (flag, given) in [
+        ("--sectors", a.sectors.is_some() && !objects),
+        (
+            "--newvelocity-delay",
+            a.newvelocity_delay.is_some() && !objects,
+        ),
+    ] {
+        if given {
+            return Err(usage(format!(
+                "{flag}: only the objects and time-warp engines take it"
+            )));
+        }
+    }
+    for (flag, given) in [
+        ("--workers", a.workers.is_some()),
+        ("--tw-window", a.tw_window.is_some()),
+        ("--tw-memory", a.tw_memory.is_some()),
+        ("--gvt-interval", a.gvt_interval.is_some()),
+        ("--tw-pure", a.tw_pure),
+    ] {
+        if given && !time_warp {
+            return Err(usage(format!("{flag}: only the time-warp engine takes it")));
+        }
+    }
+    check_outputs_apart(a)?;
+    let until = a.until.unwrap_or(scenario.until);
+    if !until.is_finite() || until < 0.0 {
+        return Err(usage(format!(
+            "--until: must be a finite number not below 0, got {until}"
+        )));
+    }
+    let cfg = RunConfig {
+        engine,
+        until,
+        check: a.check,
+        span: Default::default(),
+    };
+    #[cfg(feature = "mpi")]
+    let _mpi = if time_warp { start_mpi()? } else { None };
+    // under MPI only rank 0 writes anything
+    let root = pdes_kernel::time_warp::threads::collects_results();
+    let mut trace = match a.trace.as_ref().filter(|_| root) {
+        Some(p) => Some(TraceWriter::new(BufWriter::new(File::create(p).map_err(
+            |e| {
+                usage(format!(
+                    "{}: cannot create the trace file: {e}",
+                    p.display()
+                ))
+            },
+        )?))),
+        None => None,
+    };
+    let mut progress = Progress::new(until, a.quiet || !root);
+    let report = {
+        let mut sinks = Sinks {
+            trace: trace.as_mut(),
+            progress: progress.as_mut(),
+        };
+        execute(&scenario, &cfg, &mut sinks)
+    };
+    if let Some(p) = &progress {
+        p.bar.finish_and_clear();
+    }
+    // the trace is the run's only output written as it goes
+    let trace_failed = |e: &dyn std::fmt::Display| {
+        let path = a.trace.as_ref().map(|p| p.display().to_string());
+        usage(format!(
+            "{}: writing the trace failed: {e}",
+            path.unwrap_or_default()
+        ))
+    };
+    if let Some(t) = trace {
+        t.finish().map_err(|e| trace_failed(&e))?;
+    }
+    let report = report.map_err(|e| match e {
+        RunError::Output(m) => trace_failed(&m),
+        e => run_failure(e),
+    })?;
+    if !root {
+        return Ok(());
+    }
+    if let Some(p) = &a.final_state {
+        let fs = FinalState::new(report.outcome.t, &report.outcome.balls);
+        let text = serde_json::to_string_pretty(&fs).expect("a final state serializes");
+        std::fs::write(p, text + "\n").map_err(|e| {
+            usage(format!(
+                "{}: cannot write the final state: {e}",
+                p.display()
+            ))
+        })?;
+    }
+    print_summary(&report.summary, a.json);
+    Ok(())
+}
+
+/// Trace and progress, each optional.
+pub struct Sinks<'a, W: std::io::Write> {
+    pub trace: Option<&'a mut TraceWriter<W>>,
+    pub progress: Option<&'a mut Progress>,
+}
+
+impl<W: std::io::Write> Observer for Sinks<'_, W> {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
+        if let Some(t) = &mut self.trace {
+            t.on_event(ev, world)?;
+        }
+        if let Some(p) = &mut self.progress {
+            p.on_event(ev, world)?;
+        }
+        Ok(())
+    }
+
+    fn reads_balls(&self) -> bool {
+        self.trace.as_ref().is_some_and(|t| t.reads_balls())
+            || self.progress.as_ref().is_some_and(|p| p.reads_balls())
+    }
+}
+
+pub fn print_summary(s: &RunSummary, json: bool) {
+    if json {
+        println!("{}", serde_json::to_string(s).expect("plain data"));
+        return;
+    }
+    println!("scenario      {}", s.scenario);
+    println!("engine        {}", s.engine);
+    println!("balls         {}", s.balls);
+    println!("until         {:?}", s.until);
+    let ev = &s.events;
+    println!(
+        "events        {} (ball-ball {}, ball-cushion {}, ball-corner {}, ball-pocket {})",
+        ev.total, ev.ball_ball, ev.ball_cushion, ev.ball_corner, ev.ball_pocket
+    );
+    let ke = &s.kinetic_energy;
+    println!(
+        "energy        initial {:?}, final {:?} on the table + {:?} in pockets (relative drift {:e})",
+        ke.initial, ke.end, ke.pocketed, ke.relative_drift
+    );
+    println!("digest        {}", s.final_state_digest);
+    println!(
+        "wall          {:.3} s ({:.3} s set-up), {:.0} events/s{}",
+        s.wall_seconds,
+        s.setup_seconds,
+        s.events_per_second,
+        if s.checked {
+            ", invariants checked at every event"
+        } else {
+            ""
+        }
+    );
+    if let Some(tw) = &s.time_warp {
+        let st = &tw.stats;
+        let count = |n: u64, one: &str| match n {
+            1 => format!("1 {one}"),
+            m => format!("{m} {one}s"),
+        };
+        println!(
+            "time warp     {} on {}: efficiency {:.3}, {:.0} % of batches final, {} rollbacks, \
+             {:.2} % of messages remote, {} GVT rounds",
+            count(st.workers, "worker"),
+            count(st.ranks, "rank"),
+            tw.efficiency,
+            100.0 * st.final_batches as f64 / st.committed.max(1) as f64,
+            st.rollbacks,
+            100.0 * tw.remote_fraction,
+            st.gvt_rounds
+        );
+    }
+}
