@@ -16,6 +16,7 @@ pub mod analytic;
 pub mod bench;
 pub mod check;
 pub mod engine;
+#[cfg(feature = "pictures")]
 pub mod experiment;
 pub mod geometry;
 pub mod memory;
@@ -24,6 +25,7 @@ pub mod output;
 pub mod physics;
 pub mod polygon;
 pub mod render;
+#[cfg(feature = "pictures")]
 pub mod reversal_study;
 pub mod run;
 pub mod scenario;

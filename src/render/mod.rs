@@ -21,6 +21,11 @@
 //! stopping at every frame time to read its message statistics.
 
 pub mod html;
+#[cfg(feature = "pictures")]
+pub mod raster;
+/// Without the `pictures` feature: SVG and HTML only.
+#[cfg(not(feature = "pictures"))]
+#[path = "no_raster.rs"]
 pub mod raster;
 pub mod svg;
 
@@ -476,13 +481,25 @@ impl Output {
     }
 }
 
+/// Why a picture could not be made.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RasterError(pub String);
+
+impl fmt::Display for RasterError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for RasterError {}
+
 /// Why rendering failed.
 #[derive(Debug)]
 pub enum RenderError {
     /// The run failed or its input is unusable.
     Run(RunError),
     /// A picture could not be made (no font, …).
-    Raster(raster::RasterError),
+    Raster(RasterError),
     /// A file could not be written.
     Io {
         /// The file or folder.
@@ -512,13 +529,13 @@ impl From<RunError> for RenderError {
     }
 }
 
-impl From<raster::RasterError> for RenderError {
-    fn from(e: raster::RasterError) -> RenderError {
+impl From<RasterError> for RenderError {
+    fn from(e: RasterError) -> RenderError {
         RenderError::Raster(e)
     }
 }
 
-fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> RenderError + '_ {
+pub(crate) fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> RenderError + '_ {
     move |error| RenderError::Io {
         path: path.to_path_buf(),
         error,
@@ -526,7 +543,7 @@ fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> RenderError + '_ {
 }
 
 /// `1 frame`, `2 frames`.
-fn frames(k: usize) -> String {
+pub(crate) fn frames(k: usize) -> String {
     if k == 1 {
         "1 frame".into()
     } else {
@@ -547,9 +564,7 @@ pub fn write(
     out: &Output,
     rasterizer: Option<&raster::Rasterizer>,
 ) -> Result<String, RenderError> {
-    let need =
-        || raster::RasterError("PNG and GIF frames need a rasterizer with a font".to_string());
-    let style = svg::Style::default();
+    let need = || RasterError("PNG and GIF frames need a rasterizer with a font".to_string());
     match out {
         Output::Html(path) => {
             std::fs::write(path, html::page(rec)).map_err(io_error(path))?;
@@ -565,57 +580,8 @@ pub fn write(
                 }
             ))
         }
-        Output::Folder(dir) => {
-            let r = rasterizer.ok_or_else(need)?;
-            std::fs::create_dir_all(dir).map_err(io_error(dir))?;
-            let count = rec.shots.len();
-            for (k, shot) in rec.shots.iter().enumerate() {
-                let text = svg::frame(&rec.scene, shot, &style);
-                let name = frame_name(k, count);
-                let p = dir.join(format!("{name}.svg"));
-                std::fs::write(&p, &text).map_err(io_error(&p))?;
-                let p = dir.join(format!("{name}.png"));
-                std::fs::write(&p, r.png(&text)?).map_err(io_error(&p))?;
-            }
-            Ok(format!(
-                "{}: {} every {} as SVG and PNG ({} to {})",
-                dir.display(),
-                frames(count),
-                format_time(rec.frame_time),
-                frame_name(0, count),
-                frame_name(count.saturating_sub(1), count)
-            ))
-        }
-        Output::Gif(path) => {
-            let r = rasterizer.ok_or_else(need)?;
-            let mut file = Some(std::fs::File::create(path).map_err(io_error(path))?);
-            let mut gif: Option<raster::GifWriter<std::io::BufWriter<std::fs::File>>> = None;
-            for shot in &rec.shots {
-                let pixmap = r.pixmap(&svg::frame(&rec.scene, shot, &style))?;
-                if let Some(file) = file.take() {
-                    gif = Some(raster::GifWriter::new(
-                        std::io::BufWriter::new(file),
-                        pixmap.width(),
-                        pixmap.height(),
-                        rec.frame_time,
-                    )?);
-                }
-                if let Some(g) = &mut gif {
-                    g.add(&pixmap)?;
-                }
-            }
-            if let Some(g) = gif {
-                let mut w = g.finish()?;
-                std::io::Write::flush(&mut w).map_err(io_error(path))?;
-            }
-            Ok(format!(
-                "{}: {}, one every {} s (frame time {})",
-                path.display(),
-                frames(rec.shots.len()),
-                format_time((rec.frame_time * 100.0).round().max(2.0) / 100.0),
-                format_time(rec.frame_time)
-            ))
-        }
+        Output::Folder(dir) => raster::write_folder(rec, dir, rasterizer.ok_or_else(need)?),
+        Output::Gif(path) => raster::write_gif(rec, path, rasterizer.ok_or_else(need)?),
     }
 }
 

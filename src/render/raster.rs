@@ -7,25 +7,15 @@
 
 use resvg::tiny_skia::Pixmap;
 use resvg::usvg;
-use std::fmt;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+pub use super::RasterError;
+use super::{format_time, frame_name, frames, io_error, svg, Recording, RenderError};
 
 /// Where the font is read from when `$POOLSIM_FONT` is not set.
 pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-
-/// Why a picture could not be made.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct RasterError(pub String);
-
-impl fmt::Display for RasterError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for RasterError {}
 
 /// The font file to read: `$POOLSIM_FONT` if set, else [`DEFAULT_FONT`].
 pub fn font_path() -> PathBuf {
@@ -163,4 +153,61 @@ impl<W: Write> GifWriter<W> {
 
 fn gif_error(e: gif::EncodingError) -> RasterError {
     RasterError(format!("cannot write the GIF: {e}"))
+}
+
+/// Writes every frame of `rec` into the folder `dir` as SVG and PNG; returns one line that says
+/// what was written.
+pub fn write_folder(rec: &Recording, dir: &Path, r: &Rasterizer) -> Result<String, RenderError> {
+    let style = svg::Style::default();
+    std::fs::create_dir_all(dir).map_err(io_error(dir))?;
+    let count = rec.shots.len();
+    for (k, shot) in rec.shots.iter().enumerate() {
+        let text = svg::frame(&rec.scene, shot, &style);
+        let name = frame_name(k, count);
+        let p = dir.join(format!("{name}.svg"));
+        std::fs::write(&p, &text).map_err(io_error(&p))?;
+        let p = dir.join(format!("{name}.png"));
+        std::fs::write(&p, r.png(&text)?).map_err(io_error(&p))?;
+    }
+    Ok(format!(
+        "{}: {} every {} as SVG and PNG ({} to {})",
+        dir.display(),
+        frames(count),
+        format_time(rec.frame_time),
+        frame_name(0, count),
+        frame_name(count.saturating_sub(1), count)
+    ))
+}
+
+/// Writes the frames of `rec` as one animated GIF at `path`; returns one line that says what was
+/// written.
+pub fn write_gif(rec: &Recording, path: &Path, r: &Rasterizer) -> Result<String, RenderError> {
+    let style = svg::Style::default();
+    let mut file = Some(std::fs::File::create(path).map_err(io_error(path))?);
+    let mut gif: Option<GifWriter<std::io::BufWriter<std::fs::File>>> = None;
+    for shot in &rec.shots {
+        let pixmap = r.pixmap(&svg::frame(&rec.scene, shot, &style))?;
+        if let Some(file) = file.take() {
+            gif = Some(GifWriter::new(
+                std::io::BufWriter::new(file),
+                pixmap.width(),
+                pixmap.height(),
+                rec.frame_time,
+            )?);
+        }
+        if let Some(g) = &mut gif {
+            g.add(&pixmap)?;
+        }
+    }
+    if let Some(g) = gif {
+        let mut w = g.finish()?;
+        std::io::Write::flush(&mut w).map_err(io_error(path))?;
+    }
+    Ok(format!(
+        "{}: {}, one every {} s (frame time {})",
+        path.display(),
+        frames(rec.shots.len()),
+        format_time((rec.frame_time * 100.0).round().max(2.0) / 100.0),
+        format_time(rec.frame_time)
+    ))
 }

@@ -1,0 +1,44 @@
+//! PNG and GIF frames need the `pictures` feature. Without it a [`Rasterizer`] cannot be made:
+//! its constructors fail with one clear error, and the writers that would use one are never
+//! reached.
+
+pub use super::RasterError;
+use super::{Recording, RenderError};
+use std::path::{Path, PathBuf};
+
+/// Where the font is read from when `$POOLSIM_FONT` is not set.
+pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+/// The font file to read: `$POOLSIM_FONT` if set, else [`DEFAULT_FONT`].
+pub fn font_path() -> PathBuf {
+    std::env::var_os("POOLSIM_FONT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_FONT))
+}
+
+/// Turns SVG into pixels: not in this build (no value of this type exists).
+pub enum Rasterizer {}
+
+impl Rasterizer {
+    /// Fails: this build draws no pixels.
+    pub fn new() -> Result<Rasterizer, RasterError> {
+        Err(RasterError(
+            "PNG and GIF frames need poolsim built with the `pictures` feature".to_string(),
+        ))
+    }
+
+    /// Fails, as [`Rasterizer::new`] does.
+    pub fn with_font(_path: &Path) -> Result<Rasterizer, RasterError> {
+        Rasterizer::new()
+    }
+}
+
+/// Never called: no [`Rasterizer`] exists in this build.
+pub fn write_folder(_: &Recording, _: &Path, r: &Rasterizer) -> Result<String, RenderError> {
+    match *r {}
+}
+
+/// Never called: no [`Rasterizer`] exists in this build.
+pub fn write_gif(_: &Recording, _: &Path, r: &Rasterizer) -> Result<String, RenderError> {
+    match *r {}
+}
