@@ -840,7 +840,7 @@ fn usage_errors_say_what_is_wrong_on_one_line() {
         "all",
     ]);
     assert!(
-        line.contains("--fixed-news") && line.contains("`all`"),
+        line.contains("--fixed-news") && line.contains("'all'"),
         "{line}"
     );
     let line = bad_usage(&[

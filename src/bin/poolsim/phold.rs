@@ -2,6 +2,15 @@
 
 use crate::common::*;
 
+/// `poolsim phold --engine`: which executor runs PHOLD.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PholdEngine {
+    /// The sequential kernel.
+    Objects,
+    /// Time Warp.
+    TimeWarp,
+}
+
 /// Arguments of `poolsim phold`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PholdArgs {
@@ -19,8 +28,8 @@ pub struct PholdArgs {
     #[arg(long)]
     pub partitions: Option<u32>,
     /// objects (the sequential kernel) or time-warp.
-    #[arg(long, default_value = "objects")]
-    pub engine: String,
+    #[arg(long, value_enum, default_value = "objects")]
+    pub engine: PholdEngine,
     /// Time Warp workers per rank (default: this machine's cores).
     #[arg(long)]
     pub workers: Option<usize>,
@@ -67,19 +76,14 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
             a.remote
         )));
     }
-    let tw = match a.engine.as_str() {
-        "objects" => {
+    let tw = match a.engine {
+        PholdEngine::Objects => {
             if a.workers.is_some() {
                 return Err(usage("--workers: only the time-warp engine takes it"));
             }
             None
         }
-        "time-warp" => Some(tw_workers(a.workers)?),
-        other => {
-            return Err(usage(format!(
-                "--engine: PHOLD runs on objects or time-warp, not `{other}`"
-            )))
-        }
+        PholdEngine::TimeWarp => Some(tw_workers(a.workers)?),
     };
     if tw.is_some() {
         poolsim::memory::transparent_huge_pages(false);

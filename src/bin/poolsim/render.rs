@@ -2,6 +2,7 @@
 
 use crate::common::*;
 use crate::run::*;
+use crate::values::{sector_choice, Delay, Engine, Sectors};
 use poolsim::run::{EngineKind, FixedNews, SectorChoice};
 use poolsim::scenario::Scenario;
 use poolsim::summary::RunSummary;
@@ -22,16 +23,16 @@ pub struct RenderArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub until: Option<f64>,
     /// event-list, objects or time-warp.
-    #[arg(long, default_value = "event-list")]
-    pub engine: String,
+    #[arg(long, value_enum, default_value = "event-list")]
+    pub engine: Engine,
     /// Sectors: none, auto, N or NxM; drawn on any engine, run by the objects engines.
     #[arg(long)]
-    pub sectors: Option<String>,
+    pub sectors: Option<Sectors>,
     #[command(flatten)]
     pub gen: GenArgs,
     /// Delay of NewVelocity messages (objects engine).
     #[arg(long = "newvelocity-delay")]
-    pub newvelocity_delay: Option<String>,
+    pub newvelocity_delay: Option<Delay>,
     /// Check invariants at every event.
     #[arg(long)]
     pub check: bool,
@@ -62,8 +63,8 @@ pub fn render(a: &RenderArgs) -> Result<(), Failure> {
     let scenario = load(&a.scenario, &a.gen)?;
     let run_args = RunArgs {
         scenario: a.scenario.clone(),
-        engine: a.engine.clone(),
-        sectors: a.sectors.clone(),
+        engine: a.engine,
+        sectors: a.sectors,
         until: a.until,
         gen: a.gen.clone(),
         trace: None,
@@ -75,12 +76,12 @@ pub fn render(a: &RenderArgs) -> Result<(), Failure> {
         tw_memory: None,
         gvt_interval: None,
         tw_pure: false,
-        newvelocity_delay: a.newvelocity_delay.clone(),
+        newvelocity_delay: a.newvelocity_delay,
         fixed_news: None,
         dt: None,
         quiet: true,
     };
-    if a.engine == "time-step" {
+    if a.engine == Engine::TimeStep {
         return Err(usage(
             "--engine: render draws with event-list, objects or time-warp",
         ));
@@ -97,7 +98,7 @@ pub fn render(a: &RenderArgs) -> Result<(), Failure> {
         .unwrap_or_else(|| poolsim::render::default_frame_time(until));
     let cfg = poolsim::render::RenderConfig {
         check: a.check,
-        sectors: sector_choice(a.sectors.as_deref(), &scenario)?,
+        sectors: sector_choice(a.sectors, &scenario),
         ..poolsim::render::RenderConfig::new(engine, until, frame_time)
     };
     let (_, line) = render_to(&scenario, &cfg, &a.out)?;

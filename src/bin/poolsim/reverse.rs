@@ -2,6 +2,7 @@
 
 use crate::common::*;
 use crate::run::*;
+use crate::values::{Delay, Engine, Sectors};
 
 /// Arguments of `poolsim reverse`.
 #[derive(clap::Args, Clone, Debug)]
@@ -12,11 +13,11 @@ pub struct ReverseArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub quit: f64,
     /// event-list, time-step, objects or time-warp.
-    #[arg(long, default_value = "event-list")]
-    pub engine: String,
+    #[arg(long, value_enum, default_value = "event-list")]
+    pub engine: Engine,
     /// Sector layout of the objects engines: none, auto, N or NxM.
     #[arg(long)]
-    pub sectors: Option<String>,
+    pub sectors: Option<Sectors>,
     #[command(flatten)]
     pub gen: GenArgs,
     /// Time step of the time-step engine.
@@ -24,7 +25,7 @@ pub struct ReverseArgs {
     pub dt: Option<f64>,
     /// Delay of NewVelocity messages (objects engine).
     #[arg(long = "newvelocity-delay")]
-    pub newvelocity_delay: Option<String>,
+    pub newvelocity_delay: Option<Delay>,
     /// Check invariants at every event.
     #[arg(long)]
     pub check: bool,
@@ -43,8 +44,8 @@ pub fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
     let scenario = load(&a.scenario, &a.gen)?;
     let run_args = RunArgs {
         scenario: a.scenario.clone(),
-        engine: a.engine.clone(),
-        sectors: a.sectors.clone(),
+        engine: a.engine,
+        sectors: a.sectors,
         until: None,
         gen: a.gen.clone(),
         trace: None,
@@ -56,7 +57,7 @@ pub fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
         tw_memory: None,
         gvt_interval: None,
         tw_pure: false,
-        newvelocity_delay: a.newvelocity_delay.clone(),
+        newvelocity_delay: a.newvelocity_delay,
         fixed_news: None,
         dt: a.dt,
         quiet: true,

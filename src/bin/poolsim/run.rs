@@ -1,12 +1,13 @@
 //! `poolsim run`: one scenario on one engine, with its trace, final state and summary.
 
 use crate::common::*;
+use crate::values::{nv_delay, sector_choice, Delay, Engine, News, Sectors};
 use pdes_kernel::time_warp::TwConfig;
 use poolsim::engine::{Event, Observer, RunError, World};
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};
-use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
-use poolsim::scenario::{self, Scenario};
+use poolsim::run::{execute, EngineKind, RunConfig};
+use poolsim::scenario::Scenario;
 use poolsim::summary::RunSummary;
 use std::fs::File;
 use std::io::BufWriter;
@@ -16,12 +17,12 @@ use std::path::PathBuf;
 pub struct RunArgs {
     /// A built-in scenario name (see `poolsim scenarios`) or a TOML file.
     pub scenario: String,
-    /// event-list, time-step, objects or time-warp.
-    #[arg(long, default_value = "event-list")]
-    pub engine: String,
+    /// The engine.
+    #[arg(long, value_enum, default_value = "event-list")]
+    pub engine: Engine,
     /// Sector layout: none, auto, N or NxM (sectored engines only).
     #[arg(long)]
-    pub sectors: Option<String>,
+    pub sectors: Option<Sectors>,
     /// End time (default: the scenario's).
     #[arg(long, allow_negative_numbers = true)]
     pub until: Option<f64>,
@@ -56,13 +57,13 @@ pub struct RunArgs {
     /// nothing can roll back any more (by default such a batch runs as final).
     #[arg(long = "tw-pure")]
     pub tw_pure: bool,
-    /// Delay of NewVelocity messages (objects engines).
+    /// Delay of NewVelocity messages (objects engines): a time, or auto.
     #[arg(long = "newvelocity-delay")]
-    pub newvelocity_delay: Option<String>,
+    pub newvelocity_delay: Option<Delay>,
     /// Which balls tell cushions, pockets and corners of a new trajectory on a sectored table:
     /// near (those in sectors within reach; the default) or thesis (all: fig. 15's counts).
-    #[arg(long = "fixed-news")]
-    pub fixed_news: Option<String>,
+    #[arg(long = "fixed-news", value_enum)]
+    pub fixed_news: Option<News>,
     /// Time step of the time-step engine.
     #[arg(long, allow_negative_numbers = true)]
     pub dt: Option<f64>,
@@ -71,102 +72,17 @@ pub struct RunArgs {
     pub quiet: bool,
 }
 
-/// `--fixed-news`: near (the default) or thesis.
-pub fn fixed_news(arg: Option<&str>) -> Result<FixedNews, Failure> {
-    match arg {
-        None | Some("near") => Ok(FixedNews::Near),
-        Some("thesis") => Ok(FixedNews::Thesis),
-        Some(other) => Err(usage(format!(
-            "--fixed-news: expected near or thesis, got `{other}`"
-        ))),
-    }
-}
-
-/// `--newvelocity-delay`: absent or 0 is exact; `auto` is the thesis' choice (4.4): a ball at the
-/// fastest initial speed moves 1% of the smallest diameter in the delay.
-pub fn nv_delay(arg: Option<&str>, s: &Scenario) -> Result<NvDelay, Failure> {
-    let d = match arg {
-        None => return Ok(NvDelay::Exact),
-        Some("auto") => {
-            let vmax = s
-                .balls
-                .iter()
-                .map(|b| b.velocity.norm())
-                .fold(0.0, f64::max);
-            let dmin = s
-                .balls
-                .iter()
-                .map(|b| 2.0 * b.radius)
-                .fold(f64::INFINITY, f64::min);
-            if vmax > 0.0 && dmin.is_finite() {
-                0.01 * dmin / vmax
-            } else {
-                0.0
-            }
-        }
-        Some(text) => text.parse::<f64>().map_err(|_| {
-            usage(format!(
-                "--newvelocity-delay: expected a number or `auto`, got `{text}`"
-            ))
-        })?,
-    };
-    if !d.is_finite() || d < 0.0 {
-        return Err(usage(format!(
-            "--newvelocity-delay: must be a finite number not below 0, got {d}"
-        )));
-    }
-    Ok(if d == 0.0 {
-        NvDelay::Exact
-    } else {
-        NvDelay::Delay(d)
-    })
-}
-
-/// `--sectors`: none, auto, N (N x N) or NxM; absent means the scenario's own `[sectors]`, if
-/// any.
-pub fn sector_choice(arg: Option<&str>, s: &Scenario) -> Result<Option<SectorChoice>, Failure> {
-    let bad = || {
-        usage(format!(
-            "--sectors: expected none, auto, N or NxM (sectors per side, at least 1 each, at most \
-             {} sectors in all), got `{}`",
-            scenario::MAX_SECTORS,
-            arg.unwrap_or_default()
-        ))
-    };
-    let count = |text: &str| match text.parse::<u32>() {
-        Ok(n) if n >= 1 && u64::from(n) <= scenario::MAX_SECTORS => Ok(n),
-        _ => Err(bad()),
-    };
-    let grid = |nx: u32, ny: u32| {
-        if u64::from(nx) * u64::from(ny) > scenario::MAX_SECTORS {
-            Err(bad())
-        } else {
-            Ok(Some(SectorChoice::Grid(nx, ny)))
-        }
-    };
-    Ok(match arg {
-        None => s.sectors.as_ref().map(|_| SectorChoice::Scenario),
-        Some("none") => None,
-        Some("auto") => Some(SectorChoice::Auto),
-        Some(text) => match text.split_once(['x', 'X']) {
-            Some((nx, ny)) => grid(count(nx)?, count(ny)?)?,
-            None => {
-                let n = count(text)?;
-                grid(n, n)?
-            }
-        },
-    })
-}
-
+/// The engine the arguments ask for on `scenario`, its options checked against each other.
 pub fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
-    match a.engine.as_str() {
-        "event-list" => {
+    let news = a.fixed_news.unwrap_or(News::Near).into();
+    match a.engine {
+        Engine::EventList => {
             if let Some(flag) = a.dt.map(|_| "--dt") {
                 return Err(usage(format!("{flag}: only the time-step engine takes it")));
             }
             Ok(EngineKind::EventList)
         }
-        "time-step" => {
+        Engine::TimeStep => {
             let dt =
                 a.dt.ok_or_else(|| usage("--dt: the time-step engine needs a time step"))?;
             if !(dt.is_finite() && dt > 0.0) {
@@ -174,9 +90,9 @@ pub fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure
             }
             Ok(EngineKind::TimeStep { dt })
         }
-        "objects" => {
-            let delay = nv_delay(a.newvelocity_delay.as_deref(), scenario)?;
-            match sector_choice(a.sectors.as_deref(), scenario)? {
+        Engine::Objects => {
+            let delay = nv_delay(a.newvelocity_delay, scenario);
+            match sector_choice(a.sectors, scenario) {
                 None => Ok(EngineKind::Objects { delay }),
                 Some(_) if delay != NvDelay::Exact => Err(usage(
                     "--newvelocity-delay: the thesis' delay runs on non-sectored tables only \
@@ -185,16 +101,13 @@ pub fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure
                 Some(sectors) => {
                     poolsim::run::sector_layout(scenario, sectors)
                         .map_err(|e| usage(format!("--sectors: {e}")))?;
-                    Ok(EngineKind::Sectored {
-                        sectors,
-                        news: fixed_news(a.fixed_news.as_deref())?,
-                    })
+                    Ok(EngineKind::Sectored { sectors, news })
                 }
             }
         }
-        "time-warp" => {
-            let delay = nv_delay(a.newvelocity_delay.as_deref(), scenario)?;
-            let sectors = sector_choice(a.sectors.as_deref(), scenario)?;
+        Engine::TimeWarp => {
+            let delay = nv_delay(a.newvelocity_delay, scenario);
+            let sectors = sector_choice(a.sectors, scenario);
             if let Some(choice) = sectors {
                 if delay != NvDelay::Exact {
                     return Err(usage(
@@ -209,13 +122,9 @@ pub fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure
                 tw: tw_config(a)?,
                 delay,
                 sectors,
-                news: fixed_news(a.fixed_news.as_deref())?,
+                news,
             })
         }
-        other => Err(usage(format!(
-            "--engine: unknown engine `{other}`; available: event-list, time-step, objects, \
-             time-warp"
-        ))),
     }
 }
 
