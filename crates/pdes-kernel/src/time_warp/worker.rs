@@ -1,0 +1,1556 @@
+//! One worker: its objects, their pending messages and uncommitted batches; the loop that runs
+//! them optimistically, rolls back, commits and takes part in GVT rounds.
+
+use super::config::{TwConfig, TwStats, MAX_CASCADE_DEPTH, THREADS_GVT_INTERVAL};
+use super::fabric::*;
+use super::floor::Floor;
+use super::log::{Chain, Log};
+use super::marks::{Mark, Marks};
+use super::threads;
+use super::window::AutoWindow;
+use crate::prefetch::{prefetch, prefetch_all};
+use crate::queue::{Queue, Ranked};
+use crate::{
+    uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, Time, VTime, RESERVED_PER_OBJECT,
+    STATE_CLASSES,
+};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::cmp::Ordering;
+
+/// A message waiting in a worker's heap, with its transport name.
+struct Item<T, Msg> {
+    uid: u64,
+    p: Pending<T, Msg>,
+}
+
+impl<T: Time, Msg> Item<T, Msg> {
+    /// The delivery order; two sends of one message (the second after a rollback) by uid.
+    fn order(&self, o: &Self) -> Ordering {
+        self.p.order(&o.p).then(self.uid.cmp(&o.uid))
+    }
+
+    /// What a batch keeps of it: its name, and the envelope the model reads.
+    fn into_input(self) -> (Input, Envelope<Msg>) {
+        let input = Input {
+            uid: self.uid,
+            priority: self.p.priority,
+            retractable: self.p.retractable,
+        };
+        (input, self.p.env)
+    }
+}
+
+impl Input {
+    /// The message again, as it waited for the batch of `to` at `time` (undone by a rollback).
+    fn into_item<T: Time, Msg>(self, env: Envelope<Msg>, time: &VTime<T>, to: u32) -> Item<T, Msg> {
+        let p = Pending {
+            time: time.clone(),
+            to,
+            priority: self.priority,
+            retractable: self.retractable,
+            env,
+        };
+        Item { uid: self.uid, p }
+    }
+}
+
+impl<T: Time, Msg> PartialEq for Item<T, Msg> {
+    fn eq(&self, o: &Self) -> bool {
+        self.order(o) == Ordering::Equal
+    }
+}
+
+impl<T: Time, Msg> Eq for Item<T, Msg> {}
+
+impl<T: Time, Msg> PartialOrd for Item<T, Msg> {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl<T: Time, Msg> Ord for Item<T, Msg> {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.order(self)
+    }
+}
+
+impl<T: Time, Msg> Ranked for Item<T, Msg> {
+    fn rank(&self) -> [u64; 4] {
+        // the heap's order is the delivery order reversed
+        self.p.rank(self.uid).map(|x| !x)
+    }
+    fn same_instant(&self, o: &Self) -> bool {
+        self.p.time.key == o.p.time.key
+    }
+    fn lead(&self) -> u64 {
+        !self.p.lead()
+    }
+}
+
+/// A message an uncommitted batch sent, as its sender remembers it to annul it.
+#[derive(Clone, Debug)]
+struct Sent<T> {
+    uid: u64,
+    to: u32,
+    time: VTime<T>,
+}
+
+/// What a batch keeps of each message it handled, besides the envelope, to put it back.
+struct Input {
+    uid: u64,
+    priority: u8,
+    retractable: bool,
+}
+
+/// Vectors of finished batches, kept for the next ones: a worker runs millions of batches, and
+/// each would otherwise allocate and free the same few small vectors.
+struct Spare<T, Msg, State> {
+    /// Saved states freed by commits and rollbacks, by [`Model::state_class`]: a batch's state
+    /// is saved into one of its kind with `clone_from`, which reuses the buffers the state
+    /// holds instead of allocating.
+    states: [Vec<State>; STATE_CLASSES],
+    inputs: Vec<Vec<Input>>,
+    batches: Vec<Vec<Envelope<Msg>>>,
+    sent: Vec<Vec<(Sent<T>, u16)>>,
+    cancels: Vec<Vec<Handle>>,
+    /// What the model's handler sends, emptied after every batch.
+    pending: Vec<Pending<T, Msg>>,
+    /// Cancellations and retractions a batch makes, emptied after every batch (its messages go
+    /// out as it files them).
+    ops: Vec<Op<T, Msg>>,
+}
+
+/// Vectors of each kind kept at most.
+const SPARE: usize = 64;
+/// Saved states of each kind kept at most: as many as the uncommitted batches of a worker that
+/// runs ahead (two GVT intervals on threads), so that a worker saves states without allocating.
+const SPARE_STATES: usize = 4096;
+
+impl<T: Time, Msg, State> Default for Spare<T, Msg, State> {
+    fn default() -> Self {
+        Spare {
+            states: Default::default(),
+            inputs: Vec::new(),
+            batches: Vec::new(),
+            sent: Vec::new(),
+            cancels: Vec::new(),
+            pending: Vec::new(),
+            ops: Vec::new(),
+        }
+    }
+}
+
+/// A spare vector, or a new one.
+fn take<T>(pool: &mut Vec<Vec<T>>) -> Vec<T> {
+    pool.pop().unwrap_or_default()
+}
+
+/// Whether the message of `h` is still to come after the batch at `time` that cancels it:
+/// sent (not dropped as a send into the past) and not before that batch's instant. A model
+/// cancels only messages still to come, so a message of the same instant is taken to be.
+fn still_to_come<T: Time>(h: &Handle, time: &VTime<T>) -> bool {
+    h.uid != 0 && h.t >= time.t()
+}
+
+/// A time no later than the message of `h`, cancelled by the batch of object `by` at `at`, and
+/// after every batch before that one's place: the start of the message's instant, or within the
+/// cancelling batch's instant the first time its message can have (a handle keeps only the
+/// simulation time). A message to an object below `by` comes at a later time than `at`.
+fn not_before<T: Time>(h: &Handle, at: VTime<T>, by: u32) -> VTime<T> {
+    if h.t > at.t() {
+        VTime::start(h.t)
+    } else if h.to < by {
+        at.next_gen()
+    } else {
+        at
+    }
+}
+
+/// Keeps `v`, emptied, for another batch.
+fn give<T>(pool: &mut Vec<Vec<T>>, mut v: Vec<T>) {
+    if pool.len() < SPARE && v.capacity() > 0 {
+        v.clear();
+        pool.push(v);
+    }
+}
+
+/// A worker asks for a sweep of the heaps when marked messages are over half of its heap
+/// ([`Reduction::sweep`]).
+const ASK_SWEEP: usize = 2;
+/// A worker joins a sweep another asked for when they are over a quarter of its heap.
+const JOIN_SWEEP: usize = 4;
+
+/// A batch an object ran that is not committed yet.
+struct Done<M: Model> {
+    time: VTime<M::Time>,
+    /// The object's state before it.
+    pre_state: M::State,
+    /// Its kind ([`Model::state_class`]).
+    class: u8,
+    pre_seq: u64,
+    /// The messages it handled: their names, and the envelopes the model saw.
+    inputs: Vec<Input>,
+    batch: Vec<Envelope<M::Msg>>,
+    sent: Vec<(Sent<M::Time>, u16)>,
+    /// The messages it cancelled that were still to come.
+    cancels: Vec<Handle>,
+    cancel_calls: u32,
+    output: Vec<M::Output>,
+    /// A send into the past it tried: harmless if rolled back, a model bug if committed.
+    into_past: Option<String>,
+}
+
+/// What a batch run as final did, for [`Worker::commit_final`].
+struct Did<'a, M: Model> {
+    time: VTime<M::Time>,
+    /// The object's count of named messages before it.
+    uids: u64,
+    /// Messages it handled.
+    delivered: usize,
+    cancelled: &'a [Handle],
+    output: Vec<M::Output>,
+    into_past: Option<String>,
+}
+
+/// One object (a logical process) on its worker.
+struct Lp<M: Model> {
+    id: u32,
+    state: M::State,
+    seq: u64,
+    uids: u64,
+    /// Its uncommitted batches in its worker's log.
+    history: Chain,
+    /// Whether it is in its worker's list of objects with uncommitted batches.
+    active: bool,
+}
+
+/// Where each object lives: its worker and its index there.
+#[derive(Clone, Debug)]
+pub struct Placement {
+    place: Vec<(u32, u32)>,
+    workers: usize,
+}
+
+impl Placement {
+    /// The placement of objects given each one's worker.
+    pub fn new(worker_of: &[u32], workers: usize) -> Placement {
+        let mut counts = vec![0u32; workers];
+        let place = worker_of
+            .iter()
+            .map(|&w| {
+                let k = counts[w as usize];
+                counts[w as usize] += 1;
+                (w, k)
+            })
+            .collect();
+        Placement { place, workers }
+    }
+
+    /// The worker of object `o`.
+    pub fn worker(&self, o: u32) -> usize {
+        self.place[o as usize].0 as usize
+    }
+
+    fn local(&self, o: u32) -> usize {
+        self.place[o as usize].1 as usize
+    }
+
+    /// Starts loading where object `o` lives.
+    fn prefetch(&self, o: u32) {
+        prefetch(&self.place[o as usize]);
+    }
+
+    /// Number of workers.
+    pub fn workers(&self) -> usize {
+        self.workers
+    }
+}
+
+/// Chaos mode's state.
+struct Chaos<T, Msg> {
+    rng: ChaCha8Rng,
+    /// Ops held back, with the iteration that releases each.
+    held: Vec<(u64, Op<T, Msg>)>,
+}
+
+/// One worker: its objects, its messages, its outboxes.
+pub struct Worker<M: Model> {
+    index: usize,
+    placement: std::sync::Arc<Placement>,
+    lps: Vec<Lp<M>>,
+    /// Live and marked messages not handled yet.
+    heap: Queue<Item<M::Time, M::Msg>>,
+    /// Anti-messages and cancellations, and cancelled messages set aside.
+    marks: Marks<M::Time, M::Msg>,
+    /// The key of the batch run last: messages for it go to the pending set's instant tier.
+    current: M::Time,
+    /// Ops for this worker's objects.
+    local_ops: Vec<Op<M::Time, M::Msg>>,
+    /// Vectors for the next batches.
+    spare: Spare<M::Time, M::Msg, M::State>,
+    outbox: Vec<Vec<Op<M::Time, M::Msg>>>,
+    /// Chaos mode: its random stream and the ops it holds back.
+    chaos: Option<Chaos<M::Time, M::Msg>>,
+    iteration: u64,
+    sent_ops: i64,
+    received_ops: i64,
+    uncommitted: usize,
+    gvt: Floor,
+    /// The optimism window when none is set.
+    auto_window: AutoWindow,
+    round: u64,
+    stats: TwStats,
+    committed_stats: MessageStats,
+    /// Memory samples (uncommitted batches plus messages held) after each GVT round.
+    samples: Vec<u64>,
+    /// A failure found while committing; the run stops at the next GVT round.
+    fault: Option<String>,
+    /// Local objects with uncommitted batches (fossil collection visits only these).
+    active: Vec<u32>,
+    /// Uncommitted batches in the order they ran (committed early from the front), each
+    /// record boxed: the log's slots stay small, and a commit moves a pointer, not the record
+    /// (moved out of the log and into the commit, a record was copied three times).
+    log: Log<Box<Done<M>>>,
+    /// The floor this worker published last (with final batches only).
+    published: Floor,
+    /// Whether batches may run as final ([`TwConfig::final_batches`]).
+    final_ok: bool,
+    /// Whether the collector wants observed objects' states.
+    ship: bool,
+    /// Below every op another worker may still send here, as last found (lowered by every op
+    /// this worker sends away since).
+    final_bound: Floor,
+    /// Below every message and anti-message another worker may still send here, likewise.
+    message_bound: Floor,
+    /// Batches to wait before asking the fabric for a new bound after a failed try.
+    bound_wait: u32,
+    /// Workers of this process, whose slots each try reads (all workers but under MPI).
+    workers_here: u32,
+    /// The last batch run as final: no message or anti-message may come at or before it.
+    final_floor: Floor,
+    /// The last batch run as final below every op another worker may send: no op at all, a
+    /// cancellation included, may come at or before it.
+    cancel_floor: Floor,
+    /// The latest batch run optimistically: no uncommitted batch is later.
+    high: Option<VTime<M::Time>>,
+    /// Below every op in the outboxes.
+    outbox_floor: Floor,
+    /// What the collector needs of committed batches, until the chunk of the first GVT round
+    /// that passes them: the collector puts out a round's batches after the round before's,
+    /// and a batch run as final may be later than one another worker commits a round after.
+    to_ship: Vec<Committed<M::Time, M::State, M::Output>>,
+}
+
+/// Why a worker stopped early.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stop {
+    /// Another worker or the collector asked to stop.
+    Asked,
+    /// This worker failed: out of its memory budget, or a model bug committed.
+    Failed(String),
+}
+
+impl<M: Model> Worker<M> {
+    /// A worker holding the objects `placement` gives it, with their initial states.
+    pub fn new(
+        index: usize,
+        placement: std::sync::Arc<Placement>,
+        states: Vec<(u32, M::State)>,
+        chaos: Option<u64>,
+    ) -> Worker<M> {
+        let workers = placement.workers();
+        let n_objects = states.len();
+        Worker {
+            index,
+            lps: states
+                .into_iter()
+                .map(|(id, state)| Lp {
+                    id,
+                    state,
+                    seq: 0,
+                    uids: 0,
+                    history: Chain::EMPTY,
+                    active: false,
+                })
+                .collect(),
+            placement,
+            heap: Queue::with_capacity(RESERVED_PER_OBJECT * n_objects),
+            marks: Marks::default(),
+            current: M::Time::start(f64::NEG_INFINITY),
+            local_ops: Vec::new(),
+            spare: Spare::default(),
+            outbox: (0..workers).map(|_| Vec::new()).collect(),
+            chaos: chaos.map(|s| Chaos {
+                rng: ChaCha8Rng::seed_from_u64(s ^ (index as u64).wrapping_mul(0x9e37_79b9)),
+                held: Vec::new(),
+            }),
+            iteration: 0,
+            sent_ops: 0,
+            received_ops: 0,
+            uncommitted: 0,
+            gvt: Floor::NEG_INFINITY,
+            auto_window: AutoWindow::new(),
+            round: 0,
+            stats: TwStats {
+                workers: 1,
+                ranks: 1,
+                ..Default::default()
+            },
+            committed_stats: MessageStats::default(),
+            samples: Vec::new(),
+            fault: None,
+            active: Vec::new(),
+            log: Log::default(),
+            published: Floor::NEG_INFINITY,
+            final_ok: false,
+            ship: false,
+            final_bound: Floor::NEG_INFINITY,
+            message_bound: Floor::NEG_INFINITY,
+            bound_wait: 0,
+            workers_here: workers as u32,
+            final_floor: Floor::NEG_INFINITY,
+            cancel_floor: Floor::NEG_INFINITY,
+            high: None,
+            outbox_floor: Floor::INFINITY,
+            to_ship: Vec::new(),
+        }
+    }
+
+    /// Runs every object's `init` at `start`; its sends are routed like any others (flush
+    /// them with [`Worker::take_outbox`]). Init sends are committed at once.
+    pub fn init(&mut self, model: &M, start: &VTime<M::Time>) {
+        for k in 0..self.lps.len() {
+            let lp = &mut self.lps[k];
+            let (id, first) = (lp.id, lp.uids);
+            let mut ctx = Ctx::new(model, start.clone(), id, &mut lp.seq).named(&mut lp.uids);
+            model.init(&mut ctx, id, &mut lp.state);
+            let sent = ctx.sent;
+            assert!(ctx.cancelled.is_empty(), "init may not cancel");
+            for (n, p) in (first + 1..).zip(sent) {
+                self.committed_stats.count(model.kind(&p.env.msg));
+                self.send(uid(id, n), p);
+            }
+        }
+        self.drain_local();
+    }
+
+    /// Takes the ops waiting for workers `to` (uncounted: the caller delivers them itself,
+    /// or a fabric counts them).
+    pub fn take_outbox(&mut self, to: std::ops::Range<usize>) -> Vec<(usize, Vec<OpOf<M>>)> {
+        let mut out = Vec::new();
+        for (w, ops) in self.outbox.iter_mut().enumerate() {
+            if to.contains(&w) && !ops.is_empty() {
+                out.push((w, std::mem::take(ops)));
+            }
+        }
+        out
+    }
+
+    /// Accepts ops handed over outside a fabric (at set-up).
+    pub fn accept(&mut self, ops: Vec<Op<M::Time, M::Msg>>) {
+        for op in ops {
+            self.apply(op);
+        }
+        self.drain_local();
+    }
+
+    /// Messages waiting (not handled) on this worker, as the sequential executor counts them:
+    /// annulled and cancelled ones not yet discarded included. (Telling them apart would take
+    /// a look-up per message, 20 ms at the end of a run of 10^5 objects.)
+    pub fn pending_len(&self) -> usize {
+        self.heap.len() + self.marks.set_aside_len()
+    }
+
+    /// Exchanges each of this worker's objects' states with its entry in `states` (indexed by
+    /// object): after a run, a collector beside the workers takes the final states this way,
+    /// moving them rather than copying them; the workers get them back with
+    /// [`Worker::restore_states`] before they run again.
+    pub fn swap_states(&mut self, states: &mut [M::State]) {
+        for lp in &mut self.lps {
+            std::mem::swap(&mut lp.state, &mut states[lp.id as usize]);
+        }
+    }
+
+    /// Sets each of this worker's objects' states to a copy of its entry in `states`.
+    pub fn restore_states(&mut self, states: &[M::State]) {
+        for lp in &mut self.lps {
+            lp.state = states[lp.id as usize].clone();
+        }
+    }
+
+    /// Memory samples (uncommitted batches plus held messages) after each GVT round.
+    pub fn samples(&self) -> &[u64] {
+        &self.samples
+    }
+
+    /// Sends an op on its way.
+    fn route(&mut self, op: Op<M::Time, M::Msg>) {
+        let w = self.placement.worker(op.to());
+        if let Op::Anti { .. } = op {
+            self.stats.anti_messages += 1;
+        }
+        if w == self.index {
+            self.local_ops.push(op);
+        } else {
+            let f = op.floor();
+            self.outbox_floor = self.outbox_floor.min(f);
+            self.final_bound = self.final_bound.min(f);
+            self.message_bound = self.message_bound.min(f);
+            self.outbox[w].push(op);
+        }
+    }
+
+    fn drain_local(&mut self) {
+        while let Some(op) = self.local_ops.pop() {
+            self.apply(op);
+        }
+    }
+
+    /// Applies one op, rolling its receiver back if the op changes what the receiver's past
+    /// should have seen.
+    fn apply(&mut self, op: Op<M::Time, M::Msg>) {
+        let (to, (time, obj)) = (op.to(), op.place());
+        // a cancellation may come before a batch of messages no one can cancel run as final
+        let floor = match op {
+            Op::Msg { .. } | Op::Anti { .. } => &self.final_floor,
+            Op::Cancel { .. } | Op::Retract { .. } => &self.cancel_floor,
+        };
+        if floor.reaches(time, obj) {
+            self.fault.get_or_insert(format!(
+                "time warp: an op for object {to} at t = {} came after a later batch ran as final",
+                time.t()
+            ));
+        }
+        let li = self.placement.local(to);
+        match op {
+            Op::Msg { uid, p } => {
+                if !self.marks.arrives(uid, p.retractable) {
+                    return; // its anti-message or retraction came first
+                }
+                if p.retractable && self.marks.cancelled(uid) {
+                    self.marks.set_aside(uid, p, Mark::Cancelled, self.gvt.t);
+                    return;
+                }
+                if self.ran_past(li, &p.time) {
+                    self.rollback(li, &p.time); // a straggler
+                }
+                self.push(Item { uid, p });
+            }
+            Op::Anti { uid, time, .. } => {
+                // a cancelled message was handled by no batch that stands
+                let unseen = self.marks.cancelled(uid);
+                if !self.marks.annul(uid) && !unseen {
+                    self.undo_handling(li, &time);
+                }
+            }
+            Op::Retract { h, at, by } => self.retract(h, &at, by),
+            Op::Cancel { h, at, by, sign } => {
+                let (changed, back) = self.marks.cancel(h.uid, h.t, at.t(), sign);
+                if changed && h.to != by {
+                    self.undo_handling(li, &not_before(&h, at, by));
+                }
+                if let Some(p) = back {
+                    self.push(Item { uid: h.uid, p });
+                }
+            }
+        }
+        self.note_entries();
+    }
+
+    /// A retraction of a message of this worker by the batch of `by` at `at` (the canceller
+    /// itself never handled its message, which comes after the batch that cancels it).
+    fn retract(&mut self, h: Handle, at: &VTime<M::Time>, by: u32) {
+        let unseen = self.marks.cancelled(h.uid);
+        // with no batch uncommitted, no batch handled it
+        if !self.marks.retract(h.uid) && !unseen && h.to != by && self.high.is_some() {
+            let li = self.placement.local(h.to);
+            self.undo_handling(li, &not_before(&h, at.clone(), by));
+        }
+    }
+
+    /// Rolls local object `li` back if it may have handled a message at `time` that is gone:
+    /// the message is back in the heap after this, and its mark drops it there.
+    fn undo_handling(&mut self, li: usize, time: &VTime<M::Time>) {
+        if self.ran_past(li, time) {
+            self.rollback(li, time);
+        }
+    }
+
+    /// Puts a message in the heap, in the instant's tier if it is for the key being run.
+    #[inline(always)]
+    fn push(&mut self, it: Item<M::Time, M::Msg>) {
+        let in_instant = it.p.time.key == self.current;
+        self.heap.push(it, in_instant);
+    }
+
+    /// Undoes every batch of local object `li` at `time` or later.
+    fn rollback(&mut self, li: usize, time: &VTime<M::Time>) {
+        self.stats.rollbacks += 1;
+        while self.last_time(li).is_some_and(|t| t >= time) {
+            let lp = &mut self.lps[li];
+            let d = *self.log.pop_last(&mut lp.history).expect("a batch to undo");
+            self.uncommitted -= 1;
+            self.stats.rolled_back += 1;
+            let undone = std::mem::replace(&mut lp.state, d.pre_state);
+            lp.seq = d.pre_seq;
+            let to = lp.id;
+            let (mut inputs, mut batch, mut sent) = (d.inputs, d.batch, d.sent);
+            for (i, env) in inputs.drain(..).zip(batch.drain(..)) {
+                self.heap.push(i.into_item(env, &d.time, to), false);
+            }
+            for (s, _) in sent.drain(..) {
+                let op = Op::Anti {
+                    uid: s.uid,
+                    to: s.to,
+                    time: s.time,
+                };
+                self.route(op);
+            }
+            give(&mut self.spare.inputs, inputs);
+            give(&mut self.spare.batches, batch);
+            give(&mut self.spare.sent, sent);
+            let mut cancels = d.cancels;
+            for h in cancels.drain(..) {
+                let op = Op::Cancel {
+                    h,
+                    at: d.time.clone(),
+                    by: to,
+                    sign: -1,
+                };
+                self.route(op);
+            }
+            give(&mut self.spare.cancels, cancels);
+            self.give_state(d.class, undone);
+        }
+    }
+
+    /// A copy of the state of object `id` (local `li`), to restore if its next batch is rolled
+    /// back, with its kind ([`Model::state_class`]), for [`Worker::give_state`].
+    fn save_state(&mut self, model: &M, id: u32, li: usize) -> (u8, M::State) {
+        let class = model.state_class(id).min(STATE_CLASSES - 1);
+        let state = &self.lps[li].state;
+        let copy = match self.spare.states[class].pop() {
+            Some(mut saved) => {
+                saved.clone_from(state);
+                saved
+            }
+            None => state.clone(),
+        };
+        (class as u8, copy)
+    }
+
+    /// Keeps a saved state no batch needs any more, for [`Worker::save_state`] to reuse.
+    fn give_state(&mut self, class: u8, state: M::State) {
+        let spare = &mut self.spare.states[usize::from(class)];
+        if spare.len() < SPARE_STATES {
+            spare.push(state);
+        }
+    }
+
+    /// The smallest time of a live message waiting here (marked ones taken off the heap).
+    fn next_time(&mut self) -> Option<f64> {
+        loop {
+            let top = self.heap.peek()?;
+            let mark = self.marks.of(top.uid, top.p.retractable);
+            if mark == Mark::Live {
+                return Some(top.p.time.t());
+            }
+            let it = self.heap.pop().expect("a top");
+            self.marks.set_aside(it.uid, it.p, mark, self.gvt.t);
+        }
+    }
+
+    /// Whether the batch of `to` at `time` may run as final, by the bounds last found: as
+    /// `Some(true)` when every op another worker may still send comes after it, as
+    /// `Some(false)` when every message does and no op can change the batch anyway, because
+    /// none of its messages can be cancelled (`cancellable` false).
+    fn final_by_bounds(&self, time: &VTime<M::Time>, to: u32, cancellable: bool) -> Option<bool> {
+        if self.final_bound.passed(time, to) {
+            Some(true)
+        } else if !cancellable && self.message_bound.passed(time, to) {
+            Some(false)
+        } else {
+            None
+        }
+    }
+
+    /// Whether the batch of `to` at `time` may run as final ([`Worker::final_by_bounds`]): no
+    /// op (or, for a batch of messages no one can cancel, no message) another worker may still
+    /// send, none this worker holds back (chaos) and none waiting in its outboxes comes at or
+    /// before it. Asks the fabric again only when the last bounds do not answer and a few
+    /// batches have passed since the last try.
+    fn may_run_final<F: Fabric<M>>(
+        &mut self,
+        fabric: &F,
+        time: &VTime<M::Time>,
+        to: u32,
+        cancellable: bool,
+    ) -> Option<bool> {
+        if let Some(by) = self.final_by_bounds(time, to, cancellable) {
+            return Some(by);
+        }
+        if self.bound_wait > 0 {
+            self.bound_wait -= 1;
+            return None;
+        }
+        if let Some(peers) = fabric.peers_floor(self.index) {
+            let mut own = self.outbox_floor;
+            if let Some(c) = &self.chaos {
+                for (_, op) in &c.held {
+                    own = own.min(op.floor());
+                }
+            }
+            self.final_bound = peers.any.min(own);
+            self.message_bound = peers.messages.min(own);
+        }
+        let by = self.final_by_bounds(time, to, cancellable);
+        if by.is_none() {
+            // each try reads every worker's slot of this process twice
+            self.bound_wait = self.workers_here - 1;
+        }
+        by
+    }
+
+    /// Runs the next batch if its time is at most `limit` (and, when `final_only`, if it may
+    /// run as final); false when there is none.
+    fn step<F: Fabric<M>>(&mut self, model: &M, fabric: &F, limit: f64, final_only: bool) -> bool {
+        match self.next_time() {
+            Some(t) if t <= limit => {}
+            _ => return false,
+        }
+        if final_only {
+            let top = self.heap.peek().expect("a valid top");
+            let (time, to) = (top.p.time.clone(), top.p.to);
+            // the first batch left at the last GVT round runs regardless: no floor ever passes
+            // a key deeper than it keeps
+            if Floor::of(&time, to) > self.gvt
+                && self.may_run_final(fabric, &time, to, true).is_none()
+            {
+                return false;
+            }
+        }
+        let first = self.heap.pop().expect("a valid top");
+        let (time, to) = (first.p.time.clone(), first.p.to);
+        if self.current != time.key {
+            self.current = time.key.clone();
+        }
+        let li = self.placement.local(to);
+        debug_assert!(
+            self.last_time(li).is_none_or(|t| *t < time),
+            "batches run in order"
+        );
+        let mut inputs = take(&mut self.spare.inputs);
+        let mut batch = take(&mut self.spare.batches);
+        let mut cancellable = first.p.retractable;
+        let (input, env) = first.into_input();
+        inputs.push(input);
+        batch.push(env);
+        // the object of the message after the batch: its record loads while the batch runs
+        let mut next = None;
+        while let Some(top) = self.heap.peek() {
+            if top.p.time != time || top.p.to != to {
+                next = Some(top.p.to);
+                break;
+            }
+            let it = self.heap.pop().expect("a top");
+            match self.marks.of(it.uid, it.p.retractable) {
+                Mark::Live => {
+                    cancellable |= it.p.retractable;
+                    let (input, env) = it.into_input();
+                    inputs.push(input);
+                    batch.push(env);
+                }
+                mark => self.marks.set_aside(it.uid, it.p, mark, self.gvt.t),
+            }
+        }
+        // a batch before everything still to come is final, and so are the object's earlier
+        // ones: commit those, and run this one without saving the state
+        let by = if self.final_ok {
+            self.may_run_final(fabric, &time, to, cancellable)
+        } else {
+            None
+        };
+        let mut run_final = by.is_some();
+        if run_final {
+            let here = Floor::of(&time, to);
+            self.commit_front(model, li, &here);
+            // a key deeper than a floor keeps may leave batches of the instant uncommitted
+            run_final = self.lps[li].history.is_empty();
+            if run_final {
+                self.final_floor = here;
+                if by == Some(true) {
+                    self.cancel_floor = here;
+                } else {
+                    self.stats.final_uncancellable += 1;
+                }
+                // a batch run as final is never put back, so it keeps no names of its messages
+                inputs.clear();
+            }
+        }
+        // the next batch's object, most likely (a local one: its message is here): where it
+        // lives now, and its record once the handler has run (not at once: the record's place
+        // is itself a load, and the step would wait for it)
+        if let Some(next) = next {
+            self.placement.prefetch(next);
+        }
+        // a batch run as final saves nothing, and asks nothing of the model for it
+        let saved = (!run_final).then(|| self.save_state(model, to, li));
+        let lp = &mut self.lps[li];
+        // GVT cannot pass an instant this deep, so it would pile up batches until memory ran
+        // out; a cascade run on a state still to be rolled back may be wrong, and is stopped by
+        // the bound on uncommitted batches instead, until GVT reaches it
+        if time.key.depth() > MAX_CASCADE_DEPTH && (run_final || Floor::of(&time, to) <= self.gvt) {
+            self.fault.get_or_insert(format!(
+                "a cascade of zero-delay events at t = {} is over {MAX_CASCADE_DEPTH} steps deep \
+                 and does not end (the model keeps scheduling events at that instant)",
+                time.t()
+            ));
+        }
+        let (pre_seq, first) = (lp.seq, lp.uids);
+        let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq).named(&mut lp.uids);
+        ctx.sent = std::mem::take(&mut self.spare.pending);
+        model.handle(&mut ctx, to, &mut lp.state, &batch);
+        let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
+        let into_past = ctx.into_past;
+        self.stats.processed += 1;
+        let mut ops = std::mem::take(&mut self.spare.ops);
+        if run_final {
+            self.stats.final_batches += 1;
+            let delivered = batch.len();
+            give(&mut self.spare.batches, batch);
+            give(&mut self.spare.inputs, inputs);
+            let did = Did {
+                time,
+                uids: first,
+                delivered,
+                cancelled: &cancelled,
+                output,
+                into_past,
+            };
+            self.commit_final(model, li, did, &mut sent, &mut ops);
+        } else {
+            let mut sent_recs = take(&mut self.spare.sent);
+            for (n, p) in (first + 1..).zip(&sent) {
+                let s = Sent {
+                    uid: uid(to, n),
+                    to: p.to,
+                    time: p.time.clone(),
+                };
+                sent_recs.push((s, model.kind(&p.env.msg) as u16));
+            }
+            let mut cancels = if cancelled.is_empty() {
+                Vec::new()
+            } else {
+                take(&mut self.spare.cancels)
+            };
+            cancels.extend(cancelled.iter().filter(|h| still_to_come(h, &time)));
+            for &h in &cancels {
+                ops.push(Op::Cancel {
+                    h,
+                    at: time.clone(),
+                    by: to,
+                    sign: 1,
+                });
+            }
+            if !lp.active {
+                lp.active = true;
+                self.active.push(li as u32);
+            }
+            if self.high.as_ref().is_none_or(|h| *h < time) {
+                self.high = Some(time.clone());
+            }
+            let (class, pre_state) = saved.expect("saved: the batch is not final");
+            let done = Done {
+                time,
+                pre_state,
+                class,
+                pre_seq,
+                inputs,
+                batch,
+                sent: sent_recs,
+                cancels,
+                cancel_calls: cancelled.len() as u32,
+                output,
+                into_past,
+            };
+            self.log.push(&mut lp.history, li as u32, Box::new(done));
+            self.uncommitted += 1;
+            self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
+            for (n, p) in (first + 1..).zip(sent.drain(..)) {
+                self.send(uid(to, n), p);
+            }
+        }
+        if let Some(next) = next {
+            prefetch_all(&self.lps[self.placement.local(next)]);
+        }
+        self.spare.pending = sent;
+        for op in ops.drain(..) {
+            self.route(op);
+        }
+        self.spare.ops = ops;
+        self.drain_local();
+        true
+    }
+
+    /// Commits a batch that ran as final at once, keeping no record of it: counts it, sends
+    /// its messages, and turns its cancellations into retractions, pushed to `ops`.
+    fn commit_final(
+        &mut self,
+        model: &M,
+        li: usize,
+        did: Did<'_, M>,
+        sent: &mut Vec<Pending<M::Time, M::Msg>>,
+        ops: &mut Vec<Op<M::Time, M::Msg>>,
+    ) {
+        self.count_committed(did.into_past, did.delivered, did.cancelled.len());
+        let id = self.lps[li].id;
+        for (n, p) in (did.uids + 1..).zip(sent.drain(..)) {
+            self.committed_stats.count(model.kind(&p.env.msg));
+            self.send(uid(id, n), p);
+        }
+        // a committed cancellation is final: one of a message here is marked at once
+        for h in did.cancelled.iter().filter(|h| still_to_come(h, &did.time)) {
+            if self.placement.worker(h.to) == self.index {
+                self.retract(*h, &did.time, id);
+            } else {
+                ops.push(Op::Retract {
+                    h: *h,
+                    at: did.time.clone(),
+                    by: id,
+                });
+            }
+        }
+        let state = (self.ship && model.observed(id)).then(|| self.lps[li].state.clone());
+        self.keep_for_collector(did.time, id, state, did.output);
+    }
+
+    /// Sends a message a batch (or `init`) of this worker has just made. On this worker it goes
+    /// straight to the heap: no mark can name it yet, and its receiver needs rolling back only
+    /// if it ran ahead of it, which [`Worker::ran_past`] tells at a glance for most messages.
+    #[inline(always)]
+    fn send(&mut self, uid: u64, p: Pending<M::Time, M::Msg>) {
+        self.stats.messages += 1;
+        let w = self.placement.worker(p.to);
+        if w != self.index {
+            self.stats.remote_messages += 1;
+            self.route(Op::Msg { uid, p });
+            return;
+        }
+        debug_assert!(!self.final_floor.reaches(&p.time, p.to), "sends go forward");
+        let li = self.placement.local(p.to);
+        if self.ran_past(li, &p.time) {
+            self.rollback(li, &p.time);
+        }
+        self.push(Item { uid, p });
+        self.note_entries();
+    }
+
+    /// With every batch committed, no message can be a straggler: [`Worker::ran_past`] answers
+    /// at once again.
+    fn forget_high(&mut self) {
+        if self.uncommitted == 0 {
+            self.high = None;
+        }
+    }
+
+    /// Uncommitted batches as memory holds them: the slots of the log from the oldest to the
+    /// newest, those that batches committed out of order left empty included (an old batch far
+    /// ahead of GVT keeps them all; the memory budget counts them, so that rolling it back
+    /// frees them).
+    fn held(&self) -> usize {
+        self.log.slots()
+    }
+
+    /// The time of local object `li`'s latest uncommitted batch.
+    fn last_time(&self, li: usize) -> Option<&VTime<M::Time>> {
+        self.log.last(&self.lps[li].history).map(|d| &d.time)
+    }
+
+    /// Whether local object `li` ran a batch at `time` or later that is not committed yet.
+    fn ran_past(&self, li: usize, time: &VTime<M::Time>) -> bool {
+        // no batch ran past the latest one run: most messages are later than it
+        self.high.as_ref().is_some_and(|h| h >= time)
+            && self.last_time(li).is_some_and(|t| t >= time)
+    }
+
+    /// Notes how many messages this worker holds, for the summary's peak.
+    fn note_entries(&mut self) {
+        let held = self.heap.len() + self.marks.set_aside_len();
+        self.stats.peak_entries = self.stats.peak_entries.max(held as u64);
+    }
+
+    /// Rolls back every object that ran past the next message here, to free saved states, when
+    /// that message is later than GVT's instant.
+    fn artificial_rollback(&mut self) {
+        // batches of GVT's own instant cannot be committed yet: they are needed, not optimism
+        if self.next_time().is_none_or(|t| t <= self.gvt.t) {
+            return;
+        }
+        let top = self.heap.peek().expect("a valid top");
+        let (t, first) = (top.p.time.clone(), top.p.to);
+        // only batches after the next one in (time, object) order: the others' floor of this
+        // worker, published before, may be that next batch, and what is undone goes back below
+        // it (an object before the top's at its time already ran there, in order)
+        let after = t.next_gen();
+        for li in 0..self.lps.len() {
+            let from = if self.lps[li].id < first { &after } else { &t };
+            if self.last_time(li).is_some_and(|x| x >= from) {
+                self.stats.artificial_rollbacks += 1;
+                self.rollback(li, from);
+            }
+        }
+        self.drain_local();
+    }
+
+    /// Takes what arrived; in chaos mode holds it back a few iterations and shuffles it.
+    fn receive<F: Fabric<M>>(&mut self, fabric: &F, buf: &mut Vec<Op<M::Time, M::Msg>>) {
+        fabric.recv(self.index, buf);
+        self.received_ops += buf.len() as i64;
+        match &mut self.chaos {
+            None => {
+                for op in buf.drain(..) {
+                    self.apply(op);
+                }
+            }
+            Some(Chaos { rng, held }) => {
+                for op in buf.drain(..) {
+                    let delay = rng.gen_range(0..4u64);
+                    held.push((self.iteration + delay, op));
+                }
+                let now = self.iteration;
+                let mut due: Vec<Op<M::Time, M::Msg>> = Vec::new();
+                let mut k = 0;
+                while k < held.len() {
+                    if held[k].0 <= now {
+                        due.push(held.swap_remove(k).1);
+                    } else {
+                        k += 1;
+                    }
+                }
+                for i in (1..due.len()).rev() {
+                    let j = rng.gen_range(0..=i);
+                    due.swap(i, j);
+                }
+                for op in due {
+                    self.apply(op);
+                }
+            }
+        }
+        self.drain_local();
+    }
+
+    /// Sends the outboxes' ops, then publishes this worker's floor (the ops' inboxes cover
+    /// them from there).
+    fn flush<F: Fabric<M>>(&mut self, fabric: &F) {
+        for (w, ops) in self.take_outbox(0..self.outbox.len()) {
+            self.sent_ops += ops.len() as i64;
+            fabric.send(self.index, w, ops);
+        }
+        self.outbox_floor = Floor::INFINITY;
+        if self.final_ok {
+            let floor = self.local_min();
+            // the slot holds this floor already, or a lower one (taking the inbox lowers it)
+            if floor != self.published {
+                fabric.publish(self.index, floor);
+                self.published = floor;
+            }
+        }
+    }
+
+    /// The first batch this worker's unhandled messages and held ops may still change.
+    fn local_min(&mut self) -> Floor {
+        let mut m = match self.next_time() {
+            Some(_) => {
+                let top = self.heap.peek().expect("a valid top");
+                Floor::of(&top.p.time, top.p.to)
+            }
+            None => Floor::INFINITY,
+        };
+        if let Some(c) = &self.chaos {
+            for (_, op) in &c.held {
+                // a held cancellation keeps GVT below its batch (its floor), so that fossil
+                // collection cannot take the message it counts on for cancelled for good
+                m = m.min(op.floor());
+            }
+        }
+        m
+    }
+
+    /// Whether the heap's marked messages are more than a `1 / share` of it (and more than a
+    /// few): the test for asking for a sweep ([`ASK_SWEEP`]) and for joining one ([`JOIN_SWEEP`]).
+    fn heap_marked_over(&self, share: usize) -> bool {
+        self.marks.pending_marks() > self.heap.len() / share + 1024
+    }
+
+    /// A GVT round: returns the reduction over all workers, whose floor is GVT (every batch
+    /// before it is final).
+    fn gvt_round<F: Fabric<M>>(&mut self, fabric: &F, stop: bool) -> Result<Reduction, Stop> {
+        let mut buf = Vec::new();
+        loop {
+            self.receive(fabric, &mut buf);
+            self.flush(fabric);
+            let local = Reduction {
+                in_flight: self.sent_ops - self.received_ops,
+                floor: self.local_min(),
+                stop: u64::from(stop),
+                sweep: u64::from(self.heap_marked_over(ASK_SWEEP)),
+            };
+            let g = fabric.reduce(self.index, local);
+            if g.stop > 0 {
+                return Err(Stop::Asked);
+            }
+            if g.in_flight == 0 {
+                self.stats.gvt_rounds += 1;
+                return Ok(g);
+            }
+        }
+    }
+
+    /// Commits one optimistic batch of local object `li`: counts it and its sends, frees its
+    /// records, and keeps for the collector what its sinks see (`state` is the object's state
+    /// after it, when observed).
+    // the record stays in the box the log held: taken out, its 350 bytes would be copied
+    #[allow(clippy::boxed_local)]
+    fn commit(&mut self, li: usize, mut d: Box<Done<M>>, state: Option<M::State>) {
+        self.count_committed(d.into_past.take(), d.batch.len(), d.cancel_calls as usize);
+        // its cancellations are final now: those of messages here become retractions
+        for h in &d.cancels {
+            if self.placement.worker(h.to) == self.index {
+                self.marks.promote(h.uid, d.time.t());
+            }
+        }
+        for (_, kind) in d.sent.drain(..) {
+            self.committed_stats.count(usize::from(kind));
+        }
+        give(&mut self.spare.sent, d.sent);
+        give(&mut self.spare.inputs, d.inputs);
+        give(&mut self.spare.batches, d.batch);
+        give(&mut self.spare.cancels, d.cancels);
+        self.give_state(d.class, d.pre_state);
+        self.keep_for_collector(d.time, self.lps[li].id, state, d.output);
+    }
+
+    /// Counts a committed batch that handled `delivered` messages and made `cancels`
+    /// cancellations; a send into the past it tried is now a model bug.
+    fn count_committed(&mut self, into_past: Option<String>, delivered: usize, cancels: usize) {
+        if let Some(what) = into_past {
+            self.fault
+                .get_or_insert(format!("model bug in a committed batch: {what}"));
+        }
+        self.stats.committed += 1;
+        let cs = &mut self.committed_stats;
+        cs.batches += 1;
+        cs.delivered += delivered as u64;
+        cs.cancels += cancels as u64;
+    }
+
+    /// Keeps what the collector needs of a committed batch of object `obj`: only what its
+    /// sinks see.
+    fn keep_for_collector(
+        &mut self,
+        time: VTime<M::Time>,
+        obj: u32,
+        state: Option<M::State>,
+        output: Vec<M::Output>,
+    ) {
+        if state.is_some() || !output.is_empty() {
+            self.to_ship.push(Committed {
+                time,
+                obj,
+                state,
+                output,
+            });
+        }
+    }
+
+    /// Commits the batches of local object `li` that `floor` passed, oldest first.
+    fn commit_front(&mut self, model: &M, li: usize, floor: &Floor) {
+        // most objects have nothing uncommitted when they run a final batch
+        if self.lps[li].history.is_empty() {
+            return;
+        }
+        let observed = self.ship && model.observed(self.lps[li].id);
+        loop {
+            let lp = &mut self.lps[li];
+            if !self
+                .log
+                .first(&lp.history)
+                .is_some_and(|d| floor.passed(&d.time, lp.id))
+            {
+                break;
+            }
+            let state = observed.then(|| match self.log.second(&lp.history) {
+                Some(next) => next.pre_state.clone(),
+                None => lp.state.clone(),
+            });
+            let d = self
+                .log
+                .pop_first(&mut lp.history)
+                .expect("a batch to commit");
+            self.uncommitted -= 1;
+            self.commit(li, d, state);
+        }
+    }
+
+    /// Commits optimistic batches, oldest run first, that nothing can undo any more: before
+    /// every op the other workers may still send and before this worker's own next batch.
+    fn commit_early(&mut self, model: &M) {
+        if !self.final_ok || self.log.len() == 0 {
+            return;
+        }
+        // the floor just published is this worker's own next batch; the ops it flushed are
+        // still under `final_bound`
+        let bound = self.final_bound.min(self.published);
+        let before = self.uncommitted;
+        // the log's front is the oldest batch of its object
+        while let Some((li, d)) = self.log.front() {
+            let li = li as usize;
+            if !bound.passed(&d.time, self.lps[li].id) {
+                break;
+            }
+            self.commit_front(model, li, &bound);
+        }
+        self.stats.committed_early += (before - self.uncommitted) as u64;
+        self.forget_high();
+    }
+
+    /// Commits every batch before `gvt`: frees its saved state and messages, and returns what
+    /// the collector needs of every batch committed so far that `gvt` passed (output, and
+    /// observed states when the collector wants them), in no particular order. With `sweep`
+    /// (some worker wants its heap swept this round) drops the marked messages that are gone
+    /// for good from the heap, if they are a fair share of it.
+    fn fossil_collect(
+        &mut self,
+        model: &M,
+        gvt: Floor,
+        sweep: bool,
+    ) -> Vec<Committed<M::Time, M::State, M::Output>> {
+        let mut still = Vec::with_capacity(self.active.len());
+        for k in 0..self.active.len() {
+            let li = self.active[k] as usize;
+            self.commit_front(model, li, &gvt);
+            let lp = &mut self.lps[li];
+            if lp.history.is_empty() {
+                lp.active = false;
+            } else {
+                still.push(li as u32);
+            }
+        }
+        self.active = still;
+        // a batch run as final may come after one another worker commits only in a later round
+        let (out, later) = std::mem::take(&mut self.to_ship)
+            .into_iter()
+            .partition(|c| gvt.passed(&c.time, c.obj));
+        self.to_ship = later;
+        self.marks.collect(gvt.t);
+        // marked messages wait in the heap for their time; drop those that are gone for good
+        // when the marks outnumber the rest on some worker (this one's too, then), or are a
+        // quarter of the heap here: a sweep of a large heap takes tens of milliseconds, which
+        // the others would otherwise spend waiting at the next round
+        if sweep && self.heap_marked_over(JOIN_SWEEP) {
+            let marks = &mut self.marks;
+            self.heap
+                .retain(|it| marks.keeps(it.uid, it.p.retractable, gvt.t));
+        }
+        let held = self.heap.len() + self.marks.set_aside_len();
+        self.samples.push((self.uncommitted + held) as u64);
+        self.forget_high();
+        out
+    }
+
+    /// Runs this worker until GVT passes `until` (every batch at or before it committed) or
+    /// the run is stopped; hands committed batches to the fabric's collector each round, with
+    /// the observed objects' states when `ship`.
+    pub fn run<F: Fabric<M>>(
+        &mut self,
+        model: &M,
+        fabric: &F,
+        cfg: &TwConfig,
+        until: f64,
+        ship: bool,
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Result<(), Stop> {
+        let mut buf = Vec::new();
+        let mut since = 0u32;
+        let ranks = threads::place().1;
+        let interval = cfg.interval(ranks);
+        // uncommitted batches past which a worker runs only final ones; across ranks at least
+        // as many as at the threads' default interval, though rounds come more often there: a
+        // worker held back waits for a round, and a round across ranks is a collective of them
+        // all (held back past 512 batches, 2 ranks with a gas of 10^5 disks to t = 1 ran 7 % more rounds)
+        let ahead = 2 * if ranks > 1 {
+            interval.max(THREADS_GVT_INTERVAL)
+        } else {
+            interval
+        } as usize;
+        self.ship = ship;
+        self.workers_here = (self.placement.workers() / ranks).max(1) as u32;
+        // this run's fabric knows nothing of this worker yet: its first flush publishes
+        self.published = Floor::NEG_INFINITY;
+        self.final_ok = cfg.final_batches && fabric.shares_floors();
+        self.flush(fabric);
+        let result = loop {
+            self.iteration += 1;
+            self.receive(fabric, &mut buf);
+            let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window.width);
+            let mut limit = until.min(window);
+            // short bursts publish floors often, so that the others' batches can run as final
+            // (8 against 4: 2 workers with a gas of 10^5 disks to t = 0.5 ran 4-5 % faster in 13 of 18
+            // pairs, with 59 % of the batches final against 60 %)
+            let burst = match &mut self.chaos {
+                Some(c) => c.rng.gen_range(1..64u32),
+                None if self.final_ok => 8,
+                None => 64,
+            };
+            let mut ran = 0;
+            let mut held_back = false;
+            while ran < burst {
+                if self.held() > cfg.max_uncommitted {
+                    if self.held() > cfg.max_uncommitted.saturating_mul(4) {
+                        break;
+                    }
+                    self.artificial_rollback();
+                    limit = limit.min(self.gvt.t);
+                }
+                // far ahead of GVT: only batches that cannot be undone, until a round (another
+                // worker's, or this one's own once it has waited a round's worth) commits
+                held_back = self.final_ok && self.uncommitted > ahead;
+                if !self.step(model, fabric, limit, held_back) {
+                    break;
+                }
+                ran += 1;
+            }
+            self.flush(fabric);
+            self.commit_early(model);
+            since += ran.max(1);
+            if ran == 0 && !held_back {
+                since = interval;
+            }
+            if ran == 0 && self.chaos.is_none() {
+                std::thread::yield_now();
+            }
+            let over = self.held() > cfg.max_uncommitted.saturating_mul(4);
+            if over || self.fault.is_some() {
+                since = interval;
+            }
+            // chaos keeps each worker to its own count: the lockstep of the old rounds damps the
+            // rollback echoes that its delays provoke, which otherwise may run for seconds
+            let due = since >= interval;
+            let go = match self.chaos {
+                Some(_) => due,
+                None => fabric.round_due(self.index, self.round, due),
+            };
+            if !go {
+                continue;
+            }
+            since = 0;
+            let asked = stop.load(std::sync::atomic::Ordering::Relaxed);
+            match self.gvt_round(fabric, asked || over || self.fault.is_some()) {
+                Err(_) if self.fault.is_some() => {
+                    break Err(Stop::Failed(self.fault.take().expect("a fault")))
+                }
+                Err(_) if over => {
+                    break Err(Stop::Failed(format!(
+                        "time warp: worker {} holds {} uncommitted batches, over 4 x its budget \
+                         of {} (raise --tw-memory or narrow --tw-window)",
+                        self.index,
+                        self.held(),
+                        cfg.max_uncommitted
+                    )))
+                }
+                Err(s) => break Err(s),
+                Ok(Reduction {
+                    floor: gvt, sweep, ..
+                }) => {
+                    let moved = if self.gvt.t.is_finite() && gvt.t.is_finite() {
+                        gvt.t - self.gvt.t
+                    } else {
+                        0.0
+                    };
+                    self.auto_window
+                        .after_round(moved, self.heap.len(), &self.stats);
+                    self.gvt = gvt;
+                    let batches = self.fossil_collect(model, gvt, sweep > 0);
+                    self.round += 1;
+                    fabric.commit(Chunk {
+                        worker: self.index,
+                        round: self.round,
+                        batches,
+                        last: None,
+                        finals: Vec::new(),
+                        error: None,
+                    });
+                    if gvt.t > until {
+                        break Ok(());
+                    }
+                }
+            }
+        };
+        let error = match &result {
+            Err(Stop::Failed(m)) => Some(m.clone()),
+            _ => None,
+        };
+        let n = self.samples.len();
+        let max = |r: std::ops::Range<usize>| self.samples[r].iter().copied().max().unwrap_or(0);
+        self.stats.held_early = max(n / 10..n / 2);
+        self.stats.held_late = max(n / 2..n);
+        fabric.commit(Chunk {
+            worker: self.index,
+            round: u64::MAX,
+            batches: Vec::new(),
+            last: Some((
+                self.stats.clone(),
+                std::mem::take(&mut self.committed_stats),
+                self.pending_len() as u64,
+            )),
+            finals: if result.is_ok() && !fabric.collector_is_local() {
+                self.lps
+                    .iter()
+                    .map(|lp| (lp.id, lp.state.clone()))
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            error,
+        });
+        result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::config::ACROSS_RANKS_GVT_INTERVAL;
+    use super::super::window::window_span;
+    use super::*;
+    use crate::PlainTime;
+
+    fn handle(to: u32, t: f64) -> Handle {
+        Handle {
+            from: 5,
+            to,
+            seq: 1,
+            uid: uid(5, 1),
+            t,
+        }
+    }
+
+    #[test]
+    fn the_gvt_interval_defaults_by_where_it_runs() {
+        let c = TwConfig::default();
+        assert_eq!(
+            (c.interval(1), c.interval(2)),
+            (THREADS_GVT_INTERVAL, ACROSS_RANKS_GVT_INTERVAL)
+        );
+        let set = TwConfig {
+            gvt_interval: Some(7),
+            ..c
+        };
+        assert_eq!((set.interval(1), set.interval(3)), (7, 7));
+    }
+
+    #[test]
+    fn the_optimism_window_follows_the_rate_of_progress_not_the_rounds() {
+        let stats = |processed, rolled_back| TwStats {
+            processed,
+            rolled_back,
+            ..TwStats::default()
+        };
+        // one round after 1024 batches or 16 rounds after 64 each: the same window
+        let mut one = AutoWindow::new();
+        one.after_round(0.016, 10, &stats(1024, 0));
+        let mut many = AutoWindow::new();
+        many.after_round(0.016, 10, &stats(1024, 0));
+        for k in 1..=16 {
+            many.after_round(0.001, 10, &stats(1024 + 64 * k, 0));
+        }
+        assert!((one.width - 0.016).abs() < 1e-12, "{}", one.width);
+        assert!((many.width - one.width).abs() < 1e-12, "{}", many.width);
+        // it narrows at once where progress slows, and widens at most twofold a round
+        one.after_round(0.0016, 10, &stats(2048, 0));
+        assert!((one.width - 0.0016).abs() < 1e-12);
+        one.after_round(1.0, 10, &stats(3072, 0));
+        assert!((one.width - 0.0032).abs() < 1e-12);
+        // a worker that ran few batches keeps its window until it has run enough to tell the
+        // rate; a sample in which GVT did not move leaves the width
+        let mut slow = AutoWindow::new();
+        slow.after_round(0.5, 10, &stats(100, 0));
+        assert_eq!(slow.width, f64::INFINITY);
+        slow.after_round(0.5, 10, &stats(256, 0));
+        assert_eq!(slow.width, 4.0);
+        slow.after_round(0.0, 10, &stats(1024, 0));
+        assert_eq!(slow.width, 4.0);
+        // the span: one batch per pending message, within bounds
+        let spans = [10, 5000, 100_000].map(window_span);
+        assert_eq!(spans, [1024.0, 5000.0, 8192.0]);
+    }
+
+    #[test]
+    fn rollbacks_narrow_the_optimism_window_and_their_absence_widens_it_back() {
+        let mut w = AutoWindow::new();
+        let (mut processed, mut rolled_back) = (0, 0);
+        let mut round = |w: &mut AutoWindow, ran: u64, undone: u64| {
+            processed += ran;
+            rolled_back += undone;
+            let stats = TwStats {
+                processed,
+                rolled_back,
+                ..TwStats::default()
+            };
+            w.after_round(1.0, 2048, &stats);
+            w.scale
+        };
+        // a quarter rolled back halves the scale, down to 1/16; less doubles it back to 1
+        let scales: Vec<f64> = [300, 250, 400, 1000, 1000, 100, 0, 0, 0, 0]
+            .into_iter()
+            .map(|undone| round(&mut w, 1000, undone))
+            .collect();
+        assert_eq!(
+            scales,
+            [0.5, 0.25, 0.125, 0.0625, 0.0625, 0.125, 0.25, 0.5, 1.0, 1.0]
+        );
+        // the width follows: 1,000 batches moved GVT by 1, the span is 2,048
+        assert!((w.width - 2.048).abs() < 1e-12, "{}", w.width);
+    }
+
+    #[test]
+    fn a_cancelled_message_is_still_to_come_from_the_cancelling_instant_on() {
+        let at = VTime::<PlainTime>::start(2.0).next_gen();
+        assert!(still_to_come(&handle(3, 2.5), &at));
+        assert!(
+            still_to_come(&handle(3, 2.0), &at),
+            "its own instant: taken at its word"
+        );
+        assert!(
+            !still_to_come(&handle(3, 1.5), &at),
+            "delivered in an earlier instant"
+        );
+        let dropped = Handle {
+            uid: 0,
+            ..handle(3, 2.5)
+        };
+        assert!(
+            !still_to_come(&dropped, &at),
+            "a send into the past was never sent"
+        );
+    }
+
+    #[test]
+    fn a_receiver_rolls_back_from_no_earlier_than_the_cancellations_place() {
+        let at = VTime::<PlainTime>::start(2.0).next_gen();
+        // a later instant: from its start
+        assert_eq!(
+            not_before(&handle(3, 2.5), at.clone(), 5),
+            VTime::start(2.5)
+        );
+        // the same instant, an object after the canceller: from the cancelling batch's time
+        assert_eq!(not_before(&handle(7, 2.0), at.clone(), 5), at);
+        // an object before the canceller: its message comes at a later time than the batch
+        let after = not_before(&handle(3, 2.0), at.clone(), 5);
+        assert!(after > at);
+        assert!(
+            Floor::of(&after, 0) >= Floor::of(&at, 6),
+            "past the op's place"
+        );
+    }
+}
