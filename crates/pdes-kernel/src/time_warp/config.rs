@@ -1,6 +1,6 @@
 //! Time Warp's settings, its limits, and the statistics it reports.
 
-/// The deepest time ([`Time::depth`]: a cascade of zero-delay steps at one instant) Time Warp
+/// The deepest time ([`Time::depth`](crate::Time::depth): a cascade of zero-delay steps at one instant) Time Warp
 /// runs: its GVT does not tell times apart past a few words of their tie-break, so an instant
 /// this deep cannot commit, and one that never ends would fill memory.
 pub const MAX_CASCADE_DEPTH: usize = 1_000;
@@ -33,7 +33,7 @@ pub struct TwConfig {
     /// runs only batches at GVT; past four times this, the run stops with an error.
     pub max_uncommitted: usize,
     /// Whether a batch before every op the other workers may still send runs as final: without
-    /// saving its object's state, committed at once (see [`Fabric::peers_floor`]).
+    /// saving its object's state, committed at once (see [`Fabric::peers_floor`](super::Fabric::peers_floor)).
     pub final_batches: bool,
 }
 

@@ -26,7 +26,7 @@
 //! liveness in an object's past rolls the object back to it.
 //!
 //! A model cancels only messages still to come after the cancelling batch (the kernel's
-//! contract, [`Ctx::cancel`]). A handle keeps the message's simulation time, not its key: a
+//! contract, [`Ctx::cancel`](crate::Ctx::cancel)). A handle keeps the message's simulation time, not its key: a
 //! cancellation of a message of an earlier instant does nothing, and one of the cancelling
 //! batch's own instant is taken at its word.
 //!
@@ -57,6 +57,7 @@
 
 #[cfg(feature = "mpi")]
 pub mod mpi;
+pub mod thread_fabric;
 pub mod threads;
 
 mod config;

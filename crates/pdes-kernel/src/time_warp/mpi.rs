@@ -23,7 +23,7 @@
 //! in the round until nothing is in flight). A change to either, such as sending ops between
 //! rounds, breaks the bound.
 
-use super::threads::{Slots, ThreadReduce};
+use super::thread_fabric::{Slots, ThreadReduce, NOTHING};
 use super::{Bounds, Chunk, Fabric, Floor, Op, Reduction};
 use crate::{Model, Time};
 use mpi::collective::SystemOperation;
@@ -127,7 +127,7 @@ where
             outgoing: Mutex::new((0..ranks).map(|_| Vec::new()).collect()),
             reduce: ThreadReduce::new(per_rank),
             barrier: Barrier::new(per_rank),
-            result: Mutex::new(super::threads::NOTHING),
+            result: Mutex::new(NOTHING),
             collector: Mutex::new(collector),
         }
     }
