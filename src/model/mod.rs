@@ -2,6 +2,7 @@
 //! pockets and corners exchanging messages on a plain table (thesis fig. 3), and the same with
 //! sectors relaying news (fig. 14).
 
+pub mod layout;
 pub mod pool;
 pub mod sectored;
 
