@@ -7,7 +7,9 @@ use crate::check::Checker;
 use crate::engine::event_list::{self, EventList};
 use crate::engine::objects::Objects;
 use crate::engine::time_step::{self, TimeStep};
-use crate::engine::{BallState, Event, Frame, Observer, Outcome, RunError, Span, Table, World};
+use crate::engine::{
+    BallState, Engine, Event, Frame, Observer, Outcome, RunError, Span, Table, World,
+};
 use crate::model::pool::NvDelay;
 /// Which balls tell the fixed objects of a sectored table (re-exported for engine choices).
 pub use crate::model::sectored::FixedNews;
@@ -18,7 +20,7 @@ use crate::polygon::Polygon;
 use crate::scenario::Scenario;
 use crate::scenario::SectorSpec;
 use crate::summary::{EventTotals, KineticEnergy, MessageCounts, RunSummary, TimeWarpSummary};
-use pdes_kernel::time_warp::{TwConfig, TwStats};
+use pdes_kernel::time_warp::TwConfig;
 use std::time::Instant;
 
 /// Which engine runs.
@@ -192,6 +194,72 @@ fn check_time_resolution(scenario: &Scenario, cfg: &RunConfig) -> Result<(), Run
     Ok(())
 }
 
+/// The engine `cfg` asks for, set up on `scenario` and ready to run: the one factory of engines
+/// (event list, time step, objects plain or sectored, sequential or under Time Warp).
+pub fn build_engine(scenario: &Scenario, cfg: &RunConfig) -> Result<Box<dyn Engine>, RunError> {
+    Ok(match cfg.engine {
+        EngineKind::EventList => {
+            let opts = event_list::Options {
+                span: cfg.span,
+                ..Default::default()
+            };
+            Box::new(EventList::new(scenario, opts))
+        }
+        EngineKind::TimeStep { dt } => {
+            let steps = (cfg.until - cfg.span.start) / dt;
+            if steps > MAX_TIME_STEPS {
+                return Err(RunError::Input(format!(
+                    "--dt: {dt:?} makes {steps:.3e} steps from {:?} to {:?}, more than the \
+                     {MAX_TIME_STEPS:e} the time-step engine takes",
+                    cfg.span.start, cfg.until
+                )));
+            }
+            Box::new(TimeStep::new(
+                scenario,
+                time_step::Options { dt, span: cfg.span },
+            ))
+        }
+        kind => Box::new(
+            build_objects(scenario, kind, cfg.span)?.expect("every other kind runs objects"),
+        ),
+    })
+}
+
+/// The objects engine `kind` asks for (plain or sectored; sequential or Time Warp), set up on
+/// `scenario` at `span`; `None` for the event-list and time-step engines, which run no objects.
+pub fn build_objects(
+    scenario: &Scenario,
+    kind: EngineKind,
+    span: Span,
+) -> Result<Option<Objects>, RunError> {
+    let layout = |sectors, news| {
+        if span.frame_time.is_some() {
+            return Err(RunError::Input(
+                "the sectored engine draws no frames itself (poolsim render does)".into(),
+            ));
+        }
+        let mut layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
+        layout.fixed_news = news;
+        Ok(layout)
+    };
+    Ok(Some(match kind {
+        EngineKind::EventList | EngineKind::TimeStep { .. } => return Ok(None),
+        EngineKind::Objects { delay } => Objects::new(scenario, delay, span),
+        EngineKind::Sectored { sectors, news } => {
+            Objects::sectored(scenario, layout(sectors, news)?, span)
+        }
+        EngineKind::TimeWarp {
+            tw,
+            delay,
+            sectors,
+            news,
+        } => match sectors {
+            None => Objects::plain_on(scenario, delay, span, Some(tw)),
+            Some(choice) => Objects::sectored_on(scenario, layout(choice, news)?, span, Some(tw)),
+        },
+    }))
+}
+
 /// Runs `scenario` as `cfg` says, passing every event to `obs`.
 pub fn execute(
     scenario: &Scenario,
@@ -206,75 +274,12 @@ pub fn execute(
         .check
         .then(|| Checker::new(&initial, table.is_elastic()));
     let mut sinks = Sinks { checker, user: obs };
-    let mut time_warp: Option<TwStats> = None;
+    let mut engine = build_engine(scenario, cfg)?;
     // the engine built and its objects set up, before the first event
-    let setup;
-    let outcome = match cfg.engine {
-        EngineKind::EventList => {
-            let opts = event_list::Options {
-                span: cfg.span,
-                ..Default::default()
-            };
-            let mut e = EventList::new(scenario, opts);
-            setup = start.elapsed().as_secs_f64();
-            e.run(cfg.until, &mut sinks)?
-        }
-        EngineKind::TimeStep { dt } => {
-            let steps = (cfg.until - cfg.span.start) / dt;
-            if steps > MAX_TIME_STEPS {
-                return Err(RunError::Input(format!(
-                    "--dt: {dt:?} makes {steps:.3e} steps from {:?} to {:?}, more than the \
-                     {MAX_TIME_STEPS:e} the time-step engine takes",
-                    cfg.span.start, cfg.until
-                )));
-            }
-            let mut e = TimeStep::new(scenario, time_step::Options { dt, span: cfg.span });
-            setup = start.elapsed().as_secs_f64();
-            e.run(cfg.until, &mut sinks)?
-        }
-        EngineKind::Objects { delay } => {
-            let mut e = Objects::new(scenario, delay, cfg.span);
-            setup = start.elapsed().as_secs_f64();
-            e.run(cfg.until, &mut sinks)?
-        }
-        EngineKind::Sectored { sectors, news } => {
-            if cfg.span.frame_time.is_some() {
-                return Err(RunError::Input(
-                    "the sectored engine draws no frames itself (poolsim render does)".into(),
-                ));
-            }
-            let mut layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
-            layout.fixed_news = news;
-            let mut e = Objects::sectored(scenario, layout, cfg.span);
-            setup = start.elapsed().as_secs_f64();
-            e.run(cfg.until, &mut sinks)?
-        }
-        EngineKind::TimeWarp {
-            tw,
-            delay,
-            sectors,
-            news,
-        } => {
-            let mut e = match sectors {
-                None => Objects::plain_on(scenario, delay, cfg.span, Some(tw)),
-                Some(_) if cfg.span.frame_time.is_some() => {
-                    return Err(RunError::Input(
-                        "the sectored engine draws no frames itself (poolsim render does)".into(),
-                    ))
-                }
-                Some(choice) => {
-                    let mut layout = sector_layout(scenario, choice).map_err(RunError::Input)?;
-                    layout.fixed_news = news;
-                    Objects::sectored_on(scenario, layout, cfg.span, Some(tw))
-                }
-            };
-            setup = start.elapsed().as_secs_f64();
-            let out = e.run(cfg.until, &mut sinks)?;
-            time_warp = e.tw_stats();
-            e.free();
-            out
-        }
-    };
+    let setup = start.elapsed().as_secs_f64();
+    let outcome = engine.run(cfg.until, &mut sinks)?;
+    let time_warp = engine.tw_stats();
+    engine.free();
     // every engine ends with a sweep of the state it ends in (a tunnelled ball has no event);
     // under MPI only rank 0 collects the final state
     let collects = pdes_kernel::time_warp::threads::collects_results();

@@ -318,6 +318,48 @@ pub struct Frame {
     pub balls: Vec<BallState>,
 }
 
+/// What every engine offers once set up: run on to a time, reporting each physical event to an
+/// observer. [`crate::run::build_engine`] makes the one a run asks for.
+pub trait Engine {
+    /// Runs until the next event would come after `until`, reporting each event to `obs`, and
+    /// returns the state at `until`.
+    fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError>;
+
+    /// Time Warp's statistics, where Time Warp runs the engine.
+    fn tw_stats(&self) -> Option<pdes_kernel::time_warp::TwStats> {
+        None
+    }
+
+    /// Frees the engine's memory (Time Warp's on each worker's own thread).
+    fn free(self: Box<Self>) {}
+}
+
+impl Engine for event_list::EventList {
+    fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
+        event_list::EventList::run(self, until, obs)
+    }
+}
+
+impl Engine for time_step::TimeStep {
+    fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
+        time_step::TimeStep::run(self, until, obs)
+    }
+}
+
+impl Engine for objects::Objects {
+    fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
+        objects::Objects::run(self, until, obs)
+    }
+
+    fn tw_stats(&self) -> Option<pdes_kernel::time_warp::TwStats> {
+        objects::Objects::tw_stats(self)
+    }
+
+    fn free(self: Box<Self>) {
+        objects::Objects::free(*self);
+    }
+}
+
 /// Receives every executed physical event, in execution order, with the state just after it,
 /// and the frames of the display when the run makes them.
 pub trait Observer {

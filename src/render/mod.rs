@@ -35,7 +35,7 @@ use crate::engine::{
 };
 use crate::geometry::Vec2;
 use crate::model::sectored::Layout;
-use crate::run::{execute, sector_layout, EngineKind, RunConfig, SectorChoice};
+use crate::run::{build_objects, execute, sector_layout, EngineKind, RunConfig, SectorChoice};
 use crate::scenario::Scenario;
 use crate::summary::RunSummary;
 use pdes_kernel::Model;
@@ -327,27 +327,8 @@ fn chunked(
     engine: EngineKind,
     times: &[f64],
 ) -> Result<Option<Vec<(Frame, EventCounts, Vec<(&'static str, u64)>)>>, RunError> {
-    let mut e = match engine {
-        EngineKind::Objects { delay } => Objects::new(scenario, delay, Span::default()),
-        EngineKind::Sectored { sectors, news } => {
-            let mut layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
-            layout.fixed_news = news;
-            Objects::sectored(scenario, layout, Default::default())
-        }
-        EngineKind::TimeWarp {
-            tw,
-            delay,
-            sectors,
-            news,
-        } => match sectors {
-            None => Objects::plain_on(scenario, delay, Span::default(), Some(tw)),
-            Some(choice) => {
-                let mut layout = sector_layout(scenario, choice).map_err(RunError::Input)?;
-                layout.fixed_news = news;
-                Objects::sectored_on(scenario, layout, Span::default(), Some(tw))
-            }
-        },
-        EngineKind::EventList | EngineKind::TimeStep { .. } => return Ok(None),
+    let Some(mut e) = build_objects(scenario, engine, Span::default())? else {
+        return Ok(None);
     };
     let mut counts = EventCounts::default();
     let mut out = Vec::with_capacity(times.len());
