@@ -53,8 +53,8 @@ pub struct PholdArgs {
 /// The most PHOLD events in flight (objects times events per object): about a gigabyte.
 pub const MAX_PHOLD_EVENTS: u64 = 10_000_000;
 
-pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
-    use pdes_kernel::phold::{run, PholdConfig};
+/// Refuses values PHOLD cannot run with.
+fn check_values(a: &PholdArgs) -> Result<(), Failure> {
     let positive = |flag: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
             Ok(())
@@ -76,6 +76,13 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
             a.remote
         )));
     }
+    Ok(())
+}
+
+/// Runs `poolsim phold` and prints its report (on rank 0 under MPI).
+pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
+    use pdes_kernel::phold::{run, PholdConfig};
+    check_values(a)?;
     let tw = match a.engine {
         PholdEngine::Objects => {
             if a.workers.is_some() {
@@ -124,7 +131,13 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
     if pdes_kernel::time_warp::threads::place().0 != 0 {
         return Ok(());
     }
-    if a.json {
+    print_report(&report, a.json);
+    Ok(())
+}
+
+/// Prints a PHOLD report as text, or as one JSON object.
+fn print_report(report: &pdes_kernel::phold::PholdReport, json: bool) {
+    if json {
         println!(
             "{}",
             serde_json::to_string(&report).expect("a report serializes")
@@ -161,5 +174,4 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
             );
         }
     }
-    Ok(())
 }

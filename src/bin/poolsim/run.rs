@@ -196,17 +196,10 @@ pub fn check_outputs_apart(a: &RunArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-pub fn run(a: &RunArgs) -> Result<(), Failure> {
-    let scenario = load(&a.scenario, &a.gen)?;
-    let engine = engine_of(a, &scenario)?;
-    let objects = matches!(
-        engine,
-        EngineKind::Objects { .. } | EngineKind::Sectored { .. } | EngineKind::TimeWarp { .. }
-    );
+/// Refuses options the chosen engine does not take.
+fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure> {
+    let objects = !matches!(engine, EngineKind::EventList | EngineKind::TimeStep { .. });
     let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
-    if objects {
-        poolsim::memory::transparent_huge_pages(false);
-    }
     let sectored = matches!(
         engine,
         EngineKind::Sectored { .. }
@@ -244,6 +237,19 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
             return Err(usage(format!("{flag}: only the time-warp engine takes it")));
         }
     }
+    Ok(())
+}
+
+/// Runs `poolsim run`: the scenario on its engine, the trace as it goes, then the final state
+/// and the summary.
+pub fn run(a: &RunArgs) -> Result<(), Failure> {
+    let scenario = load(&a.scenario, &a.gen)?;
+    let engine = engine_of(a, &scenario)?;
+    let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
+    if !matches!(engine, EngineKind::EventList | EngineKind::TimeStep { .. }) {
+        poolsim::memory::transparent_huge_pages(false);
+    }
+    check_options_fit(a, &engine)?;
     check_outputs_apart(a)?;
     let until = a.until.unwrap_or(scenario.until);
     if !until.is_finite() || until < 0.0 {
@@ -302,17 +308,25 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
         return Ok(());
     }
     if let Some(p) = &a.final_state {
-        let fs = FinalState::new(report.outcome.t, &report.outcome.balls);
-        let text = serde_json::to_string_pretty(&fs).expect("a final state serializes");
-        std::fs::write(p, text + "\n").map_err(|e| {
-            usage(format!(
-                "{}: cannot write the final state: {e}",
-                p.display()
-            ))
-        })?;
+        write_final_state(p, &report.outcome)?;
     }
     print_summary(&report.summary, a.json);
     Ok(())
+}
+
+/// Writes the final state of `outcome` to `p` as pretty JSON.
+fn write_final_state(
+    p: &std::path::Path,
+    outcome: &poolsim::engine::Outcome,
+) -> Result<(), Failure> {
+    let fs = FinalState::new(outcome.t, &outcome.balls);
+    let text = serde_json::to_string_pretty(&fs).expect("a final state serializes");
+    std::fs::write(p, text + "\n").map_err(|e| {
+        usage(format!(
+            "{}: cannot write the final state: {e}",
+            p.display()
+        ))
+    })
 }
 
 /// Trace and progress, each optional.
