@@ -468,6 +468,33 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
     } else {
         vec![Vec::new(); balls.len()]
     };
+    ball_circles(&mut out, scene, view, balls);
+    if style.vectors {
+        velocity_arrows(&mut out, scene, view, balls);
+    }
+    if style.labels {
+        if names_balls(scene, view, balls) {
+            ball_labels(&mut out, scene, view, balls, &in_sectors);
+        }
+        if sectored {
+            sector_labels(&mut out, scene, view, balls, &in_sectors);
+        }
+    }
+    // Pocket labels and their lists are part of the state: always shown.
+    for (k, names) in pocket_contents(scene, balls).into_iter().enumerate() {
+        let pocket = scene
+            .table
+            .name(scene.table.fixed_id(Fixed::Pocket(k as u32)));
+        let a = pocket_anchor(scene, view, k);
+        let lines = list_lines(pocket, names);
+        text_block(&mut out, &a, &lines, "pocket-label", colour::TEXT, FONT);
+    }
+    title_and_counts(&mut out, view, shot);
+    out
+}
+
+/// Every ball on the table as a circle.
+fn ball_circles(out: &mut String, scene: &Scene, view: &View, balls: &[BallState]) {
     for (i, b) in balls.iter().enumerate() {
         if b.pocket.is_some() {
             continue;
@@ -483,84 +510,91 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
             colour::BALL
         );
     }
-    if style.vectors {
-        for (i, b) in balls.iter().enumerate() {
-            let v = b.velocity();
-            if b.pocket.is_some() || v == Vec2::ZERO {
-                continue;
-            }
-            let (x, y) = view.px(b.traj.position);
-            let (hx, hy) = view.px(b.traj.position + v);
-            let _ = write!(
-                out,
-                r#"<line class="velocity" data-ball="{}" x1="{}" y1="{}" x2="{}" y2="{}" stroke="{}" stroke-width="1.5" marker-end="url(#poolsim-arrow)"/>"#,
-                scene.table.name(i as u32),
-                n(x),
-                n(y),
-                n(hx),
-                n(hy),
-                colour::VECTOR
-            );
+}
+
+/// Every moving ball's velocity, as an arrow one time unit long.
+fn velocity_arrows(out: &mut String, scene: &Scene, view: &View, balls: &[BallState]) {
+    for (i, b) in balls.iter().enumerate() {
+        let v = b.velocity();
+        if b.pocket.is_some() || v == Vec2::ZERO {
+            continue;
+        }
+        let (x, y) = view.px(b.traj.position);
+        let (hx, hy) = view.px(b.traj.position + v);
+        let _ = write!(
+            out,
+            r#"<line class="velocity" data-ball="{}" x1="{}" y1="{}" x2="{}" y2="{}" stroke="{}" stroke-width="1.5" marker-end="url(#poolsim-arrow)"/>"#,
+            scene.table.name(i as u32),
+            n(x),
+            n(y),
+            n(hx),
+            n(hy),
+            colour::VECTOR
+        );
+    }
+}
+
+/// Each ball's name, and the sectors it is in, on the ball.
+fn ball_labels(
+    out: &mut String,
+    scene: &Scene,
+    view: &View,
+    balls: &[BallState],
+    in_sectors: &[Vec<u32>],
+) {
+    for (i, b) in balls.iter().enumerate() {
+        if b.pocket.is_some() {
+            continue;
+        }
+        let (x, y) = view.px(b.traj.position);
+        let mut lines = vec![scene.table.name(i as u32)];
+        lines.extend(
+            in_sectors[i]
+                .iter()
+                .map(|&k| Scene::sector_name(k as usize)),
+        );
+        let a = Anchor {
+            x,
+            y,
+            h: "middle",
+            v: "center",
+        };
+        text_block(
+            out,
+            &a,
+            &lines,
+            "label ball-label",
+            colour::TEXT,
+            ball_font(b.radius * view.scale),
+        );
+    }
+}
+
+/// Each sector's name and the balls in it.
+fn sector_labels(
+    out: &mut String,
+    scene: &Scene,
+    view: &View,
+    balls: &[BallState],
+    in_sectors: &[Vec<u32>],
+) {
+    let Some(layout) = &scene.sectors else {
+        return;
+    };
+    for k in 0..layout.polys.len() {
+        let names: Vec<String> = (0..balls.len())
+            .filter(|&i| in_sectors[i].contains(&(k as u32)))
+            .map(|i| scene.table.name(i as u32))
+            .collect();
+        if let Some(a) = sector_anchor(scene, view, k) {
+            let lines = list_lines(Scene::sector_name(k), names);
+            text_block(out, &a, &lines, "label sector-label", colour::SECTOR, FONT);
         }
     }
-    if style.labels {
-        if names_balls(scene, view, balls) {
-            for (i, b) in balls.iter().enumerate() {
-                if b.pocket.is_some() {
-                    continue;
-                }
-                let (x, y) = view.px(b.traj.position);
-                let mut lines = vec![scene.table.name(i as u32)];
-                lines.extend(
-                    in_sectors[i]
-                        .iter()
-                        .map(|&k| Scene::sector_name(k as usize)),
-                );
-                let a = Anchor {
-                    x,
-                    y,
-                    h: "middle",
-                    v: "center",
-                };
-                text_block(
-                    &mut out,
-                    &a,
-                    &lines,
-                    "label ball-label",
-                    colour::TEXT,
-                    ball_font(b.radius * view.scale),
-                );
-            }
-        }
-        if let (true, Some(layout)) = (sectored, &scene.sectors) {
-            for k in 0..layout.polys.len() {
-                let names: Vec<String> = (0..balls.len())
-                    .filter(|&i| in_sectors[i].contains(&(k as u32)))
-                    .map(|i| scene.table.name(i as u32))
-                    .collect();
-                if let Some(a) = sector_anchor(scene, view, k) {
-                    let lines = list_lines(Scene::sector_name(k), names);
-                    text_block(
-                        &mut out,
-                        &a,
-                        &lines,
-                        "label sector-label",
-                        colour::SECTOR,
-                        FONT,
-                    );
-                }
-            }
-        }
-    }
-    // Pocket labels and their lists are part of the state: always shown.
-    for (k, names) in pocket_contents(scene, balls).into_iter().enumerate() {
-        let pocket = scene
-            .table
-            .name(scene.table.fixed_id(Fixed::Pocket(k as u32)));
-        let a = pocket_anchor(scene, view, k);
-        let lines = list_lines(pocket, names);
-        text_block(&mut out, &a, &lines, "pocket-label", colour::TEXT, FONT);
-    }
+}
+
+/// The title, "POOL SIMULATION AT t" (thesis plates), and the counts of events and messages.
+fn title_and_counts(out: &mut String, view: &View, shot: &Shot) {
     let title = Anchor {
         x: view.width / 2.0,
         y: 14.0,
@@ -568,7 +602,7 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
         v: "down",
     };
     text_block(
-        &mut out,
+        out,
         &title,
         &[format!("POOL SIMULATION AT {}", format_time(shot.frame.t))],
         "title",
@@ -582,14 +616,13 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
         v: "up",
     };
     text_block(
-        &mut out,
+        out,
         &counts,
         &counts_lines(shot),
         "counts",
         colour::QUIET,
         11.0,
     );
-    out
 }
 
 /// One frame as a standalone SVG document.

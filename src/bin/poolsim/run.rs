@@ -245,7 +245,6 @@ fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure> {
 pub fn run(a: &RunArgs) -> Result<(), Failure> {
     let scenario = load(&a.scenario, &a.gen)?;
     let engine = engine_of(a, &scenario)?;
-    let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
     if !matches!(engine, EngineKind::EventList | EngineKind::TimeStep { .. }) {
         poolsim::memory::transparent_huge_pages(false);
     }
@@ -264,7 +263,11 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
         span: Default::default(),
     };
     #[cfg(feature = "mpi")]
-    let _mpi = if time_warp { start_mpi()? } else { None };
+    let _mpi = if matches!(cfg.engine, EngineKind::TimeWarp { .. }) {
+        start_mpi()?
+    } else {
+        None
+    };
     // under MPI only rank 0 writes anything
     let root = pdes_kernel::time_warp::threads::collects_results();
     let mut trace = match a.trace.as_ref().filter(|_| root) {
