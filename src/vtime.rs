@@ -105,17 +105,6 @@ impl Key {
         self.path.len()
     }
 
-    /// The time as an integer that orders as `f64::total_cmp` orders times.
-    #[inline]
-    pub fn time_bits(&self) -> u64 {
-        let b = self.t.to_bits();
-        if b >> 63 == 1 {
-            !b
-        } else {
-            b | 1 << 63
-        }
-    }
-
     /// Compares with the key `(t, [p])` without building it.
     #[inline]
     pub fn cmp_at(&self, t: f64, p: Pair) -> Ordering {
@@ -181,30 +170,6 @@ impl Ord for Key {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use proptest::prelude::*;
-
-    proptest! {
-        #[test]
-        fn time_bits_order_as_total_cmp(a in any::<f64>(), b in any::<f64>()) {
-            let (ka, kb) = (Key::start(a), Key::start(b));
-            prop_assert_eq!(ka.time_bits().cmp(&kb.time_bits()), a.total_cmp(&b));
-        }
-    }
-
-    #[test]
-    fn time_bits_order_signed_zeros_and_infinities() {
-        let bits = [
-            f64::NEG_INFINITY,
-            -1.0,
-            -0.0,
-            0.0,
-            1e-300,
-            1.0,
-            f64::INFINITY,
-        ]
-        .map(|t| Key::start(t).time_bits());
-        assert!(bits.windows(2).all(|w| w[0] < w[1]), "{bits:?}");
-    }
 
     #[test]
     fn a_key_cloned_into_another_equals_its_source() {

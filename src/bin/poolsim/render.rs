@@ -62,24 +62,15 @@ pub fn render_to(
 pub fn render(a: &RenderArgs) -> Result<(), Failure> {
     let scenario = load(&a.scenario, &a.gen)?;
     let run_args = RunArgs {
-        scenario: a.scenario.clone(),
-        engine: a.engine,
-        sectors: a.sectors,
         until: a.until,
-        gen: a.gen.clone(),
-        trace: None,
-        final_state: None,
-        json: false,
         check: a.check,
-        workers: None,
-        tw_window: None,
-        tw_memory: None,
-        gvt_interval: None,
-        tw_pure: false,
-        newvelocity_delay: a.newvelocity_delay,
-        fixed_news: None,
-        dt: None,
-        quiet: true,
+        ..RunArgs::for_engine(
+            &a.scenario,
+            a.engine,
+            a.sectors,
+            &a.gen,
+            a.newvelocity_delay,
+        )
     };
     if a.engine == Engine::TimeStep {
         return Err(usage(

@@ -43,24 +43,16 @@ pub fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
     }
     let scenario = load(&a.scenario, &a.gen)?;
     let run_args = RunArgs {
-        scenario: a.scenario.clone(),
-        engine: a.engine,
-        sectors: a.sectors,
-        until: None,
-        gen: a.gen.clone(),
-        trace: None,
-        final_state: None,
         json: a.json,
         check: a.check,
-        workers: None,
-        tw_window: None,
-        tw_memory: None,
-        gvt_interval: None,
-        tw_pure: false,
-        newvelocity_delay: a.newvelocity_delay,
-        fixed_news: None,
         dt: a.dt,
-        quiet: true,
+        ..RunArgs::for_engine(
+            &a.scenario,
+            a.engine,
+            a.sectors,
+            &a.gen,
+            a.newvelocity_delay,
+        )
     };
     let engine = engine_of(&run_args, &scenario)?;
     let r = poolsim::run::reverse(&scenario, engine, a.quit, a.check).map_err(run_failure)?;

@@ -72,6 +72,39 @@ pub struct RunArgs {
     pub quiet: bool,
 }
 
+impl RunArgs {
+    /// The arguments of a quiet run of `scenario` on `engine`, everything else at its default:
+    /// what `render` and `reverse` hand to [`engine_of`].
+    pub fn for_engine(
+        scenario: &str,
+        engine: Engine,
+        sectors: Option<Sectors>,
+        gen: &GenArgs,
+        newvelocity_delay: Option<Delay>,
+    ) -> RunArgs {
+        RunArgs {
+            scenario: scenario.to_string(),
+            engine,
+            sectors,
+            until: None,
+            gen: gen.clone(),
+            trace: None,
+            final_state: None,
+            json: false,
+            check: false,
+            workers: None,
+            tw_window: None,
+            tw_memory: None,
+            gvt_interval: None,
+            tw_pure: false,
+            newvelocity_delay,
+            fixed_news: None,
+            dt: None,
+            quiet: true,
+        }
+    }
+}
+
 /// The engine the arguments ask for on `scenario`, its options checked against each other.
 pub fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure> {
     let news = a.fixed_news.unwrap_or(News::Near).into();
