@@ -13,7 +13,7 @@
 //! `<pre id="poolsim-state">` (for `chromium --headless --dump-dom`).
 
 use super::svg::{self, colour, pocket_anchor, sector_anchor, Anchor, Style, View};
-use super::{format_time, Recording, Scene};
+use super::{format_time, History, Recording, Scene};
 use crate::engine::{BallState, EventKind, Fixed};
 use crate::summary::MessageCounts;
 use serde_json::{json, Value};
@@ -55,6 +55,78 @@ fn ball_json(b: &BallState) -> Value {
     json!([b.traj.position.x, b.traj.position.y, v.x, v.y, b.pocket])
 }
 
+/// Every sector's name, polygon and label anchor.
+fn sectors_json(scene: &Scene, view: &View) -> Vec<Value> {
+    let Some(layout) = &scene.sectors else {
+        return Vec::new();
+    };
+    layout
+        .polys
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let pts: Vec<[f64; 2]> = p.points.iter().map(|q| [q.x, q.y]).collect();
+            json!({
+                "name": Scene::sector_name(k),
+                "points": pts,
+                "anchor": sector_anchor(scene, view, k).map(|a| anchor_json(&a)),
+            })
+        })
+        .collect()
+}
+
+/// Every frame: its time, the events and messages up to it, and (unless the history makes them
+/// too many to be worth it) the balls.
+fn frames_json(rec: &Recording) -> Vec<Value> {
+    // With the history, the frames' positions are only a convenience for readers of the data.
+    let positions = rec.history.is_none()
+        || rec.shots.len() * rec.scene.table.n_balls as usize <= FRAME_POSITIONS_WITH_HISTORY;
+    rec.shots
+        .iter()
+        .map(|s| {
+            let mut f = json!({
+                "t": s.frame.t,
+                "events": s.events.by_kind,
+                "messages": s.messages.as_deref().map(MessageCounts::from_named),
+            });
+            if positions {
+                f["balls"] = s.frame.balls.iter().map(ball_json).collect();
+            }
+            f
+        })
+        .collect()
+}
+
+/// The history: every ball's trajectory pieces and every event, for exact positions at any time.
+fn history_json(h: &History) -> Value {
+    let pieces: Vec<Vec<Value>> = h
+        .pieces
+        .iter()
+        .map(|path| {
+            path.iter()
+                .map(|p| {
+                    let tr = p.state.traj;
+                    json!([
+                        p.from,
+                        tr.position.x,
+                        tr.position.y,
+                        tr.t0,
+                        tr.velocity.x,
+                        tr.velocity.y,
+                        p.state.pocket
+                    ])
+                })
+                .collect()
+        })
+        .collect();
+    let events: Vec<Value> = h
+        .events
+        .iter()
+        .map(|e| json!([e.t, e.kind as usize, e.a, e.b]))
+        .collect();
+    json!({"pieces": pieces, "events": events})
+}
+
 /// The recording as the player reads it.
 pub fn data(rec: &Recording) -> Value {
     let scene = &rec.scene;
@@ -72,74 +144,15 @@ pub fn data(rec: &Recording) -> Value {
         .enumerate()
         .map(|(k, name)| json!({"name": name, "anchor": anchor_json(&pocket_anchor(scene, &view, k))}))
         .collect();
-    let sectors: Vec<Value> = match &scene.sectors {
-        None => Vec::new(),
-        Some(layout) => layout
-            .polys
-            .iter()
-            .enumerate()
-            .map(|(k, p)| {
-                let pts: Vec<[f64; 2]> = p.points.iter().map(|q| [q.x, q.y]).collect();
-                json!({
-                    "name": Scene::sector_name(k),
-                    "points": pts,
-                    "anchor": sector_anchor(scene, &view, k).map(|a| anchor_json(&a)),
-                })
-            })
-            .collect(),
-    };
+    let sectors = sectors_json(scene, &view);
     let message_types: Vec<&str> = rec
         .shots
         .first()
         .and_then(|s| s.messages.as_ref())
         .map(|m| m.iter().map(|(n, _)| *n).collect())
         .unwrap_or_default();
-    // With the history, the frames' positions are only a convenience for readers of the data.
-    let positions = rec.history.is_none()
-        || rec.shots.len() * table.n_balls as usize <= FRAME_POSITIONS_WITH_HISTORY;
-    let frames: Vec<Value> = rec
-        .shots
-        .iter()
-        .map(|s| {
-            let mut f = json!({
-                "t": s.frame.t,
-                "events": s.events.by_kind,
-                "messages": s.messages.as_deref().map(MessageCounts::from_named),
-            });
-            if positions {
-                f["balls"] = s.frame.balls.iter().map(ball_json).collect();
-            }
-            f
-        })
-        .collect();
-    let history = rec.history.as_ref().map(|h| {
-        let pieces: Vec<Vec<Value>> = h
-            .pieces
-            .iter()
-            .map(|path| {
-                path.iter()
-                    .map(|p| {
-                        let tr = p.state.traj;
-                        json!([
-                            p.from,
-                            tr.position.x,
-                            tr.position.y,
-                            tr.t0,
-                            tr.velocity.x,
-                            tr.velocity.y,
-                            p.state.pocket
-                        ])
-                    })
-                    .collect()
-            })
-            .collect();
-        let events: Vec<Value> = h
-            .events
-            .iter()
-            .map(|e| json!([e.t, e.kind as usize, e.a, e.b]))
-            .collect();
-        json!({"pieces": pieces, "events": events})
-    });
+    let frames = frames_json(rec);
+    let history = rec.history.as_ref().map(history_json);
     json!({
         "scenario": scene.name,
         "engine": rec.engine,
