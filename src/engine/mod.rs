@@ -15,7 +15,6 @@ pub mod time_step;
 use crate::geometry::{Trajectory, Vec2};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
-use std::fmt;
 
 /// What kind of physical event happened; the names are the trace's `kind` strings.
 #[derive(
@@ -406,11 +405,16 @@ impl<O: Observer + ?Sized> Observer for &mut O {
 }
 
 /// Why a run stopped before its end time.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RunError {
     /// An invariant was violated (`--check`): what, where and when.
+    #[error("check failed: {0}")]
     Violation(String),
     /// One instant had more events than the cap: a cascade that does not end.
+    #[error(
+        "{events} events at the single instant t = {t}: a cascade of instantaneous collisions \
+         that does not end (a ball wedged between cushions or balls?)"
+    )]
     Cascade {
         /// The instant.
         t: f64,
@@ -418,10 +422,13 @@ pub enum RunError {
         events: u64,
     },
     /// An observer's output failed (a trace file could not be written).
+    #[error("output failed: {0}")]
     Output(String),
     /// The run was asked for something the input does not allow (a bad sector layout).
+    #[error("{0}")]
     Input(String),
     /// Time Warp failed: out of its memory budget, or a model bug committed.
+    #[error("{0}")]
     TimeWarp(String),
 }
 
@@ -481,24 +488,6 @@ impl InstantCap {
         Ok(())
     }
 }
-
-impl fmt::Display for RunError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            RunError::Violation(m) => write!(f, "check failed: {m}"),
-            RunError::Cascade { t, events } => write!(
-                f,
-                "{events} events at the single instant t = {t}: a cascade of instantaneous \
-                 collisions that does not end (a ball wedged between cushions or balls?)"
-            ),
-            RunError::Output(m) => write!(f, "output failed: {m}"),
-            RunError::Input(m) => write!(f, "{m}"),
-            RunError::TimeWarp(m) => write!(f, "{m}"),
-        }
-    }
-}
-
-impl std::error::Error for RunError {}
 
 /// Counts of executed events by kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -39,7 +39,6 @@ use crate::run::{build_objects, execute, sector_layout, EngineKind, RunConfig, S
 use crate::scenario::Scenario;
 use crate::summary::RunSummary;
 use pdes_kernel::Model;
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 /// The most frames one recording may hold.
@@ -463,57 +462,27 @@ impl Output {
 }
 
 /// Why a picture could not be made.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
 pub struct RasterError(pub String);
 
-impl fmt::Display for RasterError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for RasterError {}
-
 /// Why rendering failed.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// The run failed or its input is unusable.
-    Run(RunError),
+    #[error(transparent)]
+    Run(#[from] RunError),
     /// A picture could not be made (no font, …).
-    Raster(RasterError),
+    #[error(transparent)]
+    Raster(#[from] RasterError),
     /// A file could not be written.
+    #[error("{}: cannot write: {error}", path.display())]
     Io {
         /// The file or folder.
         path: PathBuf,
         /// What went wrong.
         error: std::io::Error,
     },
-}
-
-impl fmt::Display for RenderError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            RenderError::Run(e) => write!(f, "{e}"),
-            RenderError::Raster(e) => write!(f, "{e}"),
-            RenderError::Io { path, error } => {
-                write!(f, "{}: cannot write: {error}", path.display())
-            }
-        }
-    }
-}
-
-impl std::error::Error for RenderError {}
-
-impl From<RunError> for RenderError {
-    fn from(e: RunError) -> RenderError {
-        RenderError::Run(e)
-    }
-}
-
-impl From<RasterError> for RenderError {
-    fn from(e: RasterError) -> RenderError {
-        RenderError::Raster(e)
-    }
 }
 
 pub(crate) fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> RenderError + '_ {

@@ -7,11 +7,13 @@ use crate::time_warp::TwStats;
 use crate::{MessageStats, Model};
 
 /// Why a run stopped early.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum ExecError<E> {
     /// The sink returned an error (the run stops at the first).
+    #[error("{0}")]
     Sink(E),
     /// The executor failed: out of its memory budget, or a model bug in a committed batch.
+    #[error("{0}")]
     Failed(String),
 }
 
