@@ -127,7 +127,7 @@ impl Time for Key {
     }
 
     fn depth(&self) -> usize {
-        self.path.len()
+        Key::depth(self)
     }
 
     #[inline]

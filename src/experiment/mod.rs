@@ -39,8 +39,9 @@ pub(crate) use figures::{register_font, write_png};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-/// Where Debian's `fonts-dejavu-core` puts the font the figures' text is drawn with.
-pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+/// Where Debian's `fonts-dejavu-core` puts the font the figures' text is drawn with (the
+/// renderer's default font).
+pub use crate::render::raster::DEFAULT_FONT;
 
 /// Ball radius of the thesis gas (chapter 6), in table length units.
 const RADIUS: f64 = 30.0;

@@ -4,17 +4,7 @@
 
 pub use super::RasterError;
 use super::{Recording, RenderError};
-use std::path::{Path, PathBuf};
-
-/// Where the font is read from when `$POOLSIM_FONT` is not set.
-pub const DEFAULT_FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-
-/// The font file to read: `$POOLSIM_FONT` if set, else [`DEFAULT_FONT`].
-pub fn font_path() -> PathBuf {
-    std::env::var_os("POOLSIM_FONT")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(DEFAULT_FONT))
-}
+use std::path::Path;
 
 /// Turns SVG into pixels: not in this build (no value of this type exists).
 pub enum Rasterizer {}
