@@ -30,11 +30,11 @@ use crate::geometry::Vec2;
 use ::toml::Spanned;
 use serde::de::{self, IgnoredAny, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
-use std::collections::HashMap;
 use std::fmt;
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::path::Path;
+use toml_edit::{ImDocument, Item, Table, TableLike};
 
 /// The end time of a run when the file has no `[run] until`.
 pub const DEFAULT_UNTIL: f64 = 4.0;
@@ -409,7 +409,7 @@ fn located(text: &str, source: &str, span: Option<Range<usize>>, inv: Invalid) -
 }
 
 /// Turns toml's error (which names no key once it has the source text) into one line: the line
-/// comes from its span; the field is found by scanning the text for the table and key there.
+/// comes from its span; the field is the key or table whose text holds that span.
 fn toml_error(text: &str, source: &str, e: &::toml::de::Error) -> ScenarioError {
     if let Some(wrong) = wrong_header(text, source) {
         return wrong;
@@ -436,29 +436,57 @@ fn toml_error(text: &str, source: &str, e: &::toml::de::Error) -> ScenarioError 
 
 /// A table header of the wrong kind: `[[run]]` or `[[sectors]]` (one table each), or `[ball]`,
 /// `[cushion]`, `[pocket]` or `[sectors.polygon]` (one table per item). Serde would report
-/// these as a type mismatch inside the table.
+/// these as a type mismatch inside the table; the earliest such header in the file is named.
 fn wrong_header(text: &str, source: &str) -> Option<ScenarioError> {
-    const LISTS: [&str; 4] = ["ball", "cushion", "pocket", "sectors.polygon"];
-    scan(text, text.len()).into_iter().find_map(|item| {
-        let Item::Header { start, name, array } = item else {
-            return None;
-        };
-        let message = match (array, LISTS.contains(&name.as_str())) {
-            (true, false) if name == "run" || name == "sectors" => {
-                format!("`[[{name}]]` makes a list of tables; the file has one: write `[{name}]`")
-            }
-            (false, true) => {
-                format!("`[{name}]` is a single table; write `[[{name}]]` once per item")
-            }
-            _ => return None,
-        };
-        Some(ScenarioError {
-            source: source.to_string(),
-            line: Some(line_of(text, start)),
-            field: name,
-            message,
-        })
+    let doc = valid_prefix(text)?;
+    let root = doc.as_table();
+    let single = |name: &str| {
+        let start = root.get(name)?.as_array_of_tables()?.span()?.start;
+        let message =
+            format!("`[[{name}]]` makes a list of tables; the file has one: write `[{name}]`");
+        Some((start, name.to_string(), message))
+    };
+    let listed = |parent: &Table, name: &str, full: &str| {
+        let start = written_table(parent.get(name)?)?.span()?.start;
+        let message = format!("`[{full}]` is a single table; write `[[{full}]]` once per item");
+        Some((start, full.to_string(), message))
+    };
+    let sectors = root.get("sectors").and_then(Item::as_table);
+    let found = [
+        single("run"),
+        single("sectors"),
+        listed(root, "ball", "ball"),
+        listed(root, "cushion", "cushion"),
+        listed(root, "pocket", "pocket"),
+        sectors.and_then(|t| listed(t, "polygon", "sectors.polygon")),
+    ];
+    let (start, field, message) = found.into_iter().flatten().min_by_key(|f| f.0)?;
+    Some(ScenarioError {
+        source: source.to_string(),
+        line: Some(line_of(text, start)),
+        field,
+        message,
     })
+}
+
+/// The document as far as it is valid TOML: all of it, or the lines before the statement
+/// toml_edit rejects (such as `[[ball]]` after a `[ball]`).
+fn valid_prefix(text: &str) -> Option<ImDocument<&str>> {
+    match ImDocument::parse(text) {
+        Ok(doc) => Some(doc),
+        Err(e) => {
+            let bad = e.span()?.start.min(text.len());
+            let cut = text[..bad].rfind('\n').map_or(0, |n| n + 1);
+            ImDocument::parse(&text[..cut]).ok()
+        }
+    }
+}
+
+/// The table of `item` if the file writes it with a `[header]` of its own (not one made
+/// implicitly by a longer header or by dotted keys).
+fn written_table(item: &Item) -> Option<&Table> {
+    item.as_table()
+        .filter(|t| !t.is_implicit() && !t.is_dotted())
 }
 
 /// Rewrites the one confusing message toml gives: a table written where a single value belongs
@@ -471,193 +499,50 @@ fn clarify(message: &str) -> String {
     }
 }
 
-/// A table header or a `key = value` statement found by [`scan`], with its starting byte.
-enum Item {
-    Header {
-        start: usize,
-        name: String,
-        array: bool,
-    },
-    Key {
-        name: String,
-    },
-}
-
-/// Lists the headers and top-level statements that start at or before byte `until`.
-///
-/// A light scan of the bytes that knows just enough TOML (strings, comments, nesting of arrays
-/// and inline tables) not to mistake a line inside a value for a header; it is only used to name
-/// the field of an error in a file that toml has already parsed, and never panics.
-fn scan(text: &str, until: usize) -> Vec<Item> {
-    let b = text.as_bytes();
-    let mut items = Vec::new();
-    let mut i = 0;
-    while i < b.len() && i <= until {
-        match b[i] {
-            b' ' | b'\t' | b'\r' | b'\n' => i += 1,
-            b'#' => i = line_end(b, i),
-            b'[' => {
-                let start = i;
-                let array = b.get(i + 1) == Some(&b'[');
-                let from = i + if array { 2 } else { 1 };
-                let end = line_end(b, i);
-                let mut close = from;
-                while close < end && b[close] != b']' {
-                    close = if b[close] == b'"' || b[close] == b'\'' {
-                        skip_string(b, close).min(end)
-                    } else {
-                        close + 1
-                    };
-                }
-                items.push(Item::Header {
-                    start,
-                    name: normalize_key(&b[from.min(close)..close]),
-                    array,
-                });
-                i = end;
-            }
-            _ => {
-                let start = i;
-                let mut j = i;
-                while j < b.len() && b[j] != b'=' && b[j] != b'\n' {
-                    j = if b[j] == b'"' || b[j] == b'\'' {
-                        skip_string(b, j)
-                    } else {
-                        j + 1
-                    };
-                }
-                let j = j.min(b.len());
-                items.push(Item::Key {
-                    name: normalize_key(&b[start..j]),
-                });
-                i = if j < b.len() && b[j] == b'=' {
-                    skip_value(b, j + 1)
-                } else {
-                    j.max(i + 1)
-                };
-            }
-        }
-    }
-    items
-}
-
-/// The index of the newline ending the line that holds `i`, or the length.
-fn line_end(b: &[u8], i: usize) -> usize {
-    b[i.min(b.len())..]
-        .iter()
-        .position(|&c| c == b'\n')
-        .map_or(b.len(), |p| i + p)
-}
-
-/// The index just past the string that opens at `i` (a quote), or the end of the line or text
-/// where it is not closed. Always greater than `i`.
-fn skip_string(b: &[u8], i: usize) -> usize {
-    let q = b[i];
-    let basic = q == b'"';
-    if b.len() >= i + 3 && b[i + 1] == q && b[i + 2] == q {
-        let mut j = i + 3;
-        while j < b.len() {
-            if basic && b[j] == b'\\' {
-                j += 2;
-            } else if b[j] == q && j + 2 < b.len() && b[j + 1] == q && b[j + 2] == q {
-                let mut k = j + 3;
-                while k < b.len() && k < j + 5 && b[k] == q {
-                    k += 1;
-                }
-                return k;
-            } else {
-                j += 1;
-            }
-        }
-        return b.len();
-    }
-    let mut j = i + 1;
-    while j < b.len() {
-        if b[j] == q {
-            return j + 1;
-        }
-        if b[j] == b'\n' {
-            return j;
-        }
-        j += if basic && b[j] == b'\\' { 2 } else { 1 };
-    }
-    b.len()
-}
-
-/// The index of the newline that ends the value starting at `i`, skipping strings, comments and
-/// the lines of multi-line arrays and inline tables.
-fn skip_value(b: &[u8], mut i: usize) -> usize {
-    let mut depth = 0usize;
-    while i < b.len() {
-        match b[i] {
-            b'"' | b'\'' => {
-                i = skip_string(b, i);
-                continue;
-            }
-            b'#' => {
-                i = line_end(b, i);
-                continue;
-            }
-            b'[' | b'{' => depth += 1,
-            b']' | b'}' => depth = depth.saturating_sub(1),
-            b'\n' if depth == 0 => return i,
-            _ => {}
-        }
-        i += 1;
-    }
-    b.len()
-}
-
-/// A key or header name as written, with the spaces around its dots removed.
-fn normalize_key(bytes: &[u8]) -> String {
-    let s = String::from_utf8_lossy(bytes);
-    let parts: Vec<&str> = s.split('.').map(str::trim).collect();
-    parts.join(".")
-}
-
-/// The field path (like `ball[2].radius`) of the statement or header that holds byte `offset`.
+/// The field path (like `ball[2].radius`) of the deepest key, table or list entry whose text
+/// holds byte `offset`, read from toml_edit's spans; empty where none does.
 fn field_at(text: &str, offset: usize) -> String {
-    let mut counts: HashMap<String, usize> = HashMap::new();
-    let mut table = String::new();
-    let mut key: Option<String> = None;
-    for item in scan(text, offset) {
-        match item {
-            Item::Header { name, array, .. } => {
-                key = None;
-                table = if array {
-                    let c = counts.entry(name.clone()).or_insert(0);
-                    *c += 1;
-                    format!("{name}[{c}]")
-                } else {
-                    // A sub-table of an array entry (`[ball.extra]`) belongs to the last entry.
-                    let mut best = name.clone();
-                    for (array_name, c) in &counts {
-                        if let Some(tail) = name.strip_prefix(&format!("{array_name}.")) {
-                            best = format!("{array_name}[{c}].{tail}");
-                        }
-                    }
-                    best
-                };
-            }
-            Item::Key { name } => key = Some(name),
+    let path = ImDocument::parse(text)
+        .ok()
+        .and_then(|doc| path_in(doc.as_table(), offset));
+    one_line(&path.unwrap_or_default())
+}
+
+/// Whether `span` holds byte `offset` (an empty span holds its start).
+fn holds(span: Option<Range<usize>>, offset: usize) -> bool {
+    span.is_some_and(|s| s.start <= offset && offset < s.end.max(s.start + 1))
+}
+
+/// The path, below `table`, of the deepest entry whose text holds byte `offset`.
+fn path_in(table: &dyn TableLike, offset: usize) -> Option<String> {
+    table.iter().find_map(|(name, item)| {
+        if let Some(list) = item.as_array_of_tables() {
+            return list.iter().enumerate().find_map(|(i, entry)| {
+                let here = format!("{name}[{}]", i + 1);
+                match path_in(entry, offset) {
+                    Some(below) => Some(format!("{here}.{below}")),
+                    None => holds(entry.span(), offset).then_some(here),
+                }
+            });
         }
-    }
-    let field = match key {
-        Some(k) if table.is_empty() => k,
-        Some(k) => format!("{table}.{k}"),
-        None => table,
-    };
-    one_line(&field)
+        if let Some(below) = item.as_table_like().and_then(|t| path_in(t, offset)) {
+            return Some(format!("{name}.{below}"));
+        }
+        // A `[table]` spans its header and statements; a value spans from its key.
+        let key = table.get_key_value(name).and_then(|(k, _)| k.span());
+        let span = match (key, item.span()) {
+            (Some(k), Some(v)) if !item.is_table() => Some(k.start..v.end),
+            (_, span) => span,
+        };
+        holds(span, offset).then(|| name.to_string())
+    })
 }
 
 /// The 1-based line of the header `[name]`, if the text has one.
 fn header_line(text: &str, name: &str) -> Option<usize> {
-    scan(text, text.len())
-        .into_iter()
-        .find_map(|item| match item {
-            Item::Header { start, name: n, .. } if n == name => Some(line_of(text, start)),
-            _ => None,
-        })
+    let doc = ImDocument::parse(text).ok()?;
+    let table = written_table(doc.as_table().get(name)?)?;
+    Some(line_of(text, table.span()?.start))
 }
 
 #[cfg(test)]
@@ -966,7 +851,7 @@ grid = [2, 3]
     }
 
     #[test]
-    fn field_scan_skips_strings_and_multiline_values() {
+    fn field_paths_skip_strings_and_multiline_values() {
         let text = "a = \"\"\"\n[x]\n\"\"\"\nb = [\n [1],\n]\n[[ball]]\nc = '['\nd = 1\n";
         let at = text.find("d = 1").unwrap();
         assert_eq!(field_at(text, at), "ball[1].d");
