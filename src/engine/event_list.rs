@@ -504,27 +504,8 @@ impl EventList {
             }
             let (queue, mut balls) = self.calendar();
             let first = queue.first(&mut balls);
-            if let Some(r) = &self.reversal {
-                let before = first.is_none_or(|i| *r < self.own[i as usize].queued);
-                if before && r.t <= until {
-                    let r = self.reversal.take().expect("checked above");
-                    self.reverse(&r);
-                    continue;
-                }
-            }
-            if let Some(f) = self.span.frame(self.frames) {
-                let frame = Key::at(f, DISPLAY);
-                let before = first.is_none_or(|i| frame < self.own[i as usize].queued)
-                    && self.reversal.as_ref().is_none_or(|r| frame < *r);
-                if before && f <= until {
-                    self.frames += 1;
-                    let frame = Frame {
-                        t: f,
-                        balls: self.state_at(f),
-                    };
-                    obs.on_frame(&frame, &self.table)?;
-                    continue;
-                }
+            if self.interlude(first, until, obs)? {
+                continue;
             }
             let Some(i) = first else {
                 break;
@@ -539,71 +520,124 @@ impl EventList {
                 self.cross(i, self.own[i as usize].cross_cell);
                 continue;
             }
-            match self.own[i as usize].phys.partner {
+            let (kind, a, b) = match self.own[i as usize].phys.partner {
                 Partner::Nothing => break,
-                Partner::Return(f) => {
-                    let b = &mut self.slots[i as usize];
-                    let cell = self.grid.cell_at(b.traj.position);
-                    b.cell = cell;
-                    b.counter = b.counter.wrapping_add(1);
-                    self.grid.insert(i, cell);
-                    self.pocket[i as usize] = None;
-                    self.own[i as usize].fixed_at = key.clone();
-                    self.predict(i);
-                    self.emit(&key, EventKind::BallPocket, i, f, &mut counts, obs)?;
-                }
+                Partner::Return(f) => (self.come_back(i, &key), i, f),
                 Partner::Ball(j, seen) if self.slots[j as usize].counter != seen => {
                     self.stats.stale += 1;
                     self.predict(i);
                     continue;
                 }
-                Partner::Ball(j, _) => {
-                    let (a, b) = (i.min(j), i.max(j));
-                    let (sa, sb) = (self.slots[a as usize], self.slots[b as usize]);
-                    prefetch(&self.own[j as usize]);
-                    self.grid.prefetch_near(sa.cell);
-                    self.grid.prefetch_near(sb.cell);
-                    let (va, vb) = physics::ball_ball_velocities(
-                        sa.traj.at(key.t),
-                        sa.traj.velocity,
-                        self.own[a as usize].mass,
-                        sb.traj.at(key.t),
-                        sb.traj.velocity,
-                        self.own[b as usize].mass,
-                    );
-                    self.set_velocity(a, &key, va);
-                    self.set_velocity(b, &key, vb);
-                    let (near_a, near_b) = (self.gather(a), self.gather(b));
-                    self.predict_among(a, &near_a);
-                    self.predict_among(b, &near_b);
-                    self.emit(&key, EventKind::BallBall, a, b, &mut counts, obs)?;
-                }
-                Partner::Fixed(f) => {
-                    let b = self.slots[i as usize];
-                    let p = b.traj.at(key.t);
-                    match self.table.bounce(f, p, b.traj.velocity) {
-                        Some(v) => self.set_velocity(i, &key, v),
-                        None => {
-                            self.set_velocity(i, &key, b.traj.velocity);
-                            let Fixed::Pocket(k) = self.table.fixed(f) else {
-                                unreachable!("only pockets swallow balls")
-                            };
-                            self.pocket[i as usize] = Some(k);
-                            self.grid.remove(i);
-                            self.slots[i as usize].cell = NOT_ON_TABLE;
-                        }
-                    }
-                    self.predict(i);
-                    let kind = self.table.event_kind(f);
-                    self.emit(&key, kind, i, f, &mut counts, obs)?;
-                }
-            }
+                Partner::Ball(j, _) => self.collide(i, j, &key),
+                Partner::Fixed(f) => (self.hit(i, f, &key), i, f),
+            };
+            self.emit(&key, kind, a, b, &mut counts, obs)?;
         }
         self.now = self.now.max(until);
-        Ok(Outcome {
+        Ok(self.outcome(until, counts))
+    }
+
+    /// What comes before the first queued event (`first`) if anything does by `until`: the
+    /// reversal, or a frame, which it then carries out. Whether it did.
+    #[inline]
+    fn interlude(
+        &mut self,
+        first: Option<u32>,
+        until: f64,
+        obs: &mut dyn Observer,
+    ) -> Result<bool, RunError> {
+        if let Some(r) = &self.reversal {
+            let before = first.is_none_or(|i| *r < self.own[i as usize].queued);
+            if before && r.t <= until {
+                let r = self.reversal.take().expect("checked above");
+                self.reverse(&r);
+                return Ok(true);
+            }
+        }
+        if let Some(f) = self.span.frame(self.frames) {
+            let frame = Key::at(f, DISPLAY);
+            let before = first.is_none_or(|i| frame < self.own[i as usize].queued)
+                && self.reversal.as_ref().is_none_or(|r| frame < *r);
+            if before && f <= until {
+                self.frames += 1;
+                let frame = Frame {
+                    t: f,
+                    balls: self.state_at(f),
+                };
+                obs.on_frame(&frame, &self.table)?;
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+
+    /// Pocketed ball `i` comes back out at `key` (after a reversal). The event's kind.
+    #[inline]
+    fn come_back(&mut self, i: u32, key: &Key) -> EventKind {
+        let b = &mut self.slots[i as usize];
+        let cell = self.grid.cell_at(b.traj.position);
+        b.cell = cell;
+        b.counter = b.counter.wrapping_add(1);
+        self.grid.insert(i, cell);
+        self.pocket[i as usize] = None;
+        self.own[i as usize].fixed_at = key.clone();
+        self.predict(i);
+        EventKind::BallPocket
+    }
+
+    /// Balls `i` and `j` collide at `key`: both take their new velocities and predict their next
+    /// events among their neighbours. The event, its balls in order.
+    #[inline]
+    fn collide(&mut self, i: u32, j: u32, key: &Key) -> (EventKind, u32, u32) {
+        let (a, b) = (i.min(j), i.max(j));
+        let (sa, sb) = (self.slots[a as usize], self.slots[b as usize]);
+        prefetch(&self.own[j as usize]);
+        self.grid.prefetch_near(sa.cell);
+        self.grid.prefetch_near(sb.cell);
+        let (va, vb) = physics::ball_ball_velocities(
+            sa.traj.at(key.t),
+            sa.traj.velocity,
+            self.own[a as usize].mass,
+            sb.traj.at(key.t),
+            sb.traj.velocity,
+            self.own[b as usize].mass,
+        );
+        self.set_velocity(a, key, va);
+        self.set_velocity(b, key, vb);
+        let (near_a, near_b) = (self.gather(a), self.gather(b));
+        self.predict_among(a, &near_a);
+        self.predict_among(b, &near_b);
+        (EventKind::BallBall, a, b)
+    }
+
+    /// Ball `i` hits fixed object `f` at `key`: it bounces, or drops into a pocket and leaves the
+    /// grid. The event's kind.
+    #[inline]
+    fn hit(&mut self, i: u32, f: u32, key: &Key) -> EventKind {
+        let b = self.slots[i as usize];
+        let p = b.traj.at(key.t);
+        match self.table.bounce(f, p, b.traj.velocity) {
+            Some(v) => self.set_velocity(i, key, v),
+            None => {
+                self.set_velocity(i, key, b.traj.velocity);
+                let Fixed::Pocket(k) = self.table.fixed(f) else {
+                    unreachable!("only pockets swallow balls")
+                };
+                self.pocket[i as usize] = Some(k);
+                self.grid.remove(i);
+                self.slots[i as usize].cell = NOT_ON_TABLE;
+            }
+        }
+        self.predict(i);
+        self.table.event_kind(f)
+    }
+
+    /// The state at `until`, with the events counted and the engine's statistics.
+    fn outcome(&self, until: f64, events: EventCounts) -> Outcome {
+        Outcome {
             t: until,
             balls: self.state_at(until),
-            events: counts,
+            events,
             engine_stats: vec![
                 ("predictions", self.stats.predictions as f64),
                 ("stale_events", self.stats.stale as f64),
@@ -611,7 +645,7 @@ impl EventList {
                 ("max_cascade_depth", self.stats.max_depth as f64),
             ],
             messages: Vec::new(),
-        })
+        }
     }
 
     /// Turns every ball around at the reversal key `r` (thesis 4.6): balls on the table reverse

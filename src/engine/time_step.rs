@@ -237,95 +237,122 @@ impl TimeStep {
         let mut counts = EventCounts::default();
         let n = self.balls.len() as u32;
         while self.t < until {
-            let stop = match self.reverse_at {
-                Some(r) if r > self.t && r < until => r,
-                _ => until,
-            };
-            // Steps end on the grid start + k dt (no drift from adding dt up), or at the stop;
-            // a grid point within a hair of the stop is the stop, so no sliver step follows.
-            let prev = self.t;
-            let next = self.start + (self.steps_done + 1) as f64 * self.dt;
-            if next <= stop + 1e-9 * self.dt {
-                self.steps_done += 1;
-                self.t = next.min(stop);
-            } else {
-                self.t = stop;
-            }
-            let step = self.t - prev;
+            let step = self.advance_clock(until);
             self.stats.steps += 1;
-            for i in 0..n {
-                let b = &mut self.balls[i as usize];
-                if b.pocket.is_some() {
-                    continue;
-                }
-                b.traj = Trajectory {
-                    position: b.traj.position + step * b.traj.velocity,
-                    velocity: b.traj.velocity,
-                    t0: self.t,
-                };
-                let c = self.grid.cell_at(b.traj.position);
-                if self.grid.cell_of(i) != Some(c) {
-                    self.grid.remove(i);
-                    self.grid.insert(i, c);
-                }
-            }
+            self.move_balls(step);
             for i in 0..n {
                 self.fixed_contacts(i, &mut counts, obs)?;
             }
             for i in 0..n {
-                let Some(cell) = self.grid.cell_of(i) else {
-                    continue;
-                };
-                let mut near = Vec::new();
-                self.grid.for_each_near(cell, |j| {
-                    if j > i {
-                        near.push(j)
-                    }
-                });
-                near.sort_unstable();
-                for j in near {
-                    self.stats.pair_tests += 1;
-                    let (a, b) = (self.balls[i as usize], self.balls[j as usize]);
-                    let sigma = a.radius + b.radius;
-                    let dp = b.traj.position - a.traj.position;
-                    let dv = b.traj.velocity - a.traj.velocity;
-                    if dp.norm2() >= sigma * sigma {
-                        continue;
-                    }
-                    if dp.dot(dv) >= 0.0 {
-                        self.stats.overlapping_separating += 1;
-                        continue;
-                    }
-                    let late = backwards_contact(dp, dv, sigma);
-                    self.note_lateness((sigma - dp.norm()) / a.radius.min(b.radius), late);
-                    let (va, vb) = physics::ball_ball_velocities(
-                        a.traj.position,
-                        a.traj.velocity,
-                        a.mass,
-                        b.traj.position,
-                        b.traj.velocity,
-                        b.mass,
-                    );
-                    self.set_velocity(i, va);
-                    self.set_velocity(j, vb);
-                    self.emit(EventKind::BallBall, i, j, &mut counts, obs)?;
-                }
+                self.ball_contacts(i, &mut counts, obs)?;
             }
             self.bring_back(&mut counts, obs)?;
             if self.reverse_at == Some(self.t) {
                 self.reverse();
             }
         }
+        Ok(self.outcome(until, counts))
+    }
+
+    /// Moves the clock to the end of the next step and returns the step's length. Steps end on
+    /// the grid start + k dt (no drift from adding dt up), or at the stop (`until` or the
+    /// reversal); a grid point within a hair of the stop is the stop, so no sliver step follows.
+    fn advance_clock(&mut self, until: f64) -> f64 {
+        let stop = match self.reverse_at {
+            Some(r) if r > self.t && r < until => r,
+            _ => until,
+        };
+        let prev = self.t;
+        let next = self.start + (self.steps_done + 1) as f64 * self.dt;
+        if next <= stop + 1e-9 * self.dt {
+            self.steps_done += 1;
+            self.t = next.min(stop);
+        } else {
+            self.t = stop;
+        }
+        self.t - prev
+    }
+
+    /// Moves every ball on the table by `step` and files it in its new cell.
+    fn move_balls(&mut self, step: f64) {
+        for i in 0..self.balls.len() as u32 {
+            let b = &mut self.balls[i as usize];
+            if b.pocket.is_some() {
+                continue;
+            }
+            b.traj = Trajectory {
+                position: b.traj.position + step * b.traj.velocity,
+                velocity: b.traj.velocity,
+                t0: self.t,
+            };
+            let c = self.grid.cell_at(b.traj.position);
+            if self.grid.cell_of(i) != Some(c) {
+                self.grid.remove(i);
+                self.grid.insert(i, c);
+            }
+        }
+    }
+
+    /// Ball `i` against the higher-numbered balls near it, in order: each pair found
+    /// overlapping and closing collides now.
+    fn ball_contacts(
+        &mut self,
+        i: u32,
+        counts: &mut EventCounts,
+        obs: &mut dyn Observer,
+    ) -> Result<(), RunError> {
+        let Some(cell) = self.grid.cell_of(i) else {
+            return Ok(());
+        };
+        let mut near = Vec::new();
+        self.grid.for_each_near(cell, |j| {
+            if j > i {
+                near.push(j)
+            }
+        });
+        near.sort_unstable();
+        for j in near {
+            self.stats.pair_tests += 1;
+            let (a, b) = (self.balls[i as usize], self.balls[j as usize]);
+            let sigma = a.radius + b.radius;
+            let dp = b.traj.position - a.traj.position;
+            let dv = b.traj.velocity - a.traj.velocity;
+            if dp.norm2() >= sigma * sigma {
+                continue;
+            }
+            if dp.dot(dv) >= 0.0 {
+                self.stats.overlapping_separating += 1;
+                continue;
+            }
+            let late = backwards_contact(dp, dv, sigma);
+            self.note_lateness((sigma - dp.norm()) / a.radius.min(b.radius), late);
+            let (va, vb) = physics::ball_ball_velocities(
+                a.traj.position,
+                a.traj.velocity,
+                a.mass,
+                b.traj.position,
+                b.traj.velocity,
+                b.mass,
+            );
+            self.set_velocity(i, va);
+            self.set_velocity(j, vb);
+            self.emit(EventKind::BallBall, i, j, counts, obs)?;
+        }
+        Ok(())
+    }
+
+    /// The state at the end of a run to `until`, with the events counted and the statistics.
+    fn outcome(&self, until: f64, events: EventCounts) -> Outcome {
         let s = self.stats;
         let mean_late = if s.contacts > 0 {
             s.total_lateness / s.contacts as f64
         } else {
             0.0
         };
-        Ok(Outcome {
+        Outcome {
             t: self.t.max(until),
             balls: self.balls.clone(),
-            events: counts,
+            events,
             engine_stats: vec![
                 ("dt", self.dt),
                 ("steps", s.steps as f64),
@@ -339,7 +366,7 @@ impl TimeStep {
                 ),
             ],
             messages: Vec::new(),
-        })
+        }
     }
 }
 

@@ -84,6 +84,93 @@ impl BallInfo {
         }
     }
 
+    /// Ball `me` meets ball `partner`, on trajectory `other`, now: it takes its velocity after
+    /// the collision, computed with the lower-numbered ball first so that both partners compute
+    /// the same numbers. The event to report, from the higher-numbered ball only (once a pair).
+    #[inline]
+    pub fn collide(
+        &mut self,
+        me: u32,
+        partner: u32,
+        other: &BallInfo,
+        now: &VTime<Key>,
+    ) -> Option<Event> {
+        let t = now.t();
+        let p = self.traj.at(t);
+        let q = other.traj.at(t);
+        let (mine, theirs) = (self.traj.velocity, other.traj.velocity);
+        let v = if me < partner {
+            physics::ball_ball_velocities(p, mine, self.mass, q, theirs, other.mass).0
+        } else {
+            physics::ball_ball_velocities(q, theirs, other.mass, p, mine, self.mass).1
+        };
+        self.traj = Trajectory {
+            position: p,
+            velocity: v,
+            t0: t,
+        };
+        self.fix(&now.key);
+        (me > partner).then_some(Event {
+            t,
+            kind: EventKind::BallBall,
+            a: partner,
+            b: me,
+        })
+    }
+
+    /// Ball `me` hits fixed object `f` of `table` now: it bounces off a cushion or a corner, or
+    /// drops into a pocket. The event to report.
+    #[inline]
+    pub fn hit(&mut self, me: u32, f: u32, table: &Table, now: &VTime<Key>) -> Event {
+        let t = now.t();
+        let p = self.traj.at(t);
+        match table.bounce(f, p, self.traj.velocity) {
+            Some(v) => self.traj.velocity = v,
+            None => {
+                let Fixed::Pocket(k) = table.fixed(f) else {
+                    unreachable!("only pockets swallow balls")
+                };
+                self.pocket = Some(k);
+            }
+        }
+        self.traj.position = p;
+        self.traj.t0 = t;
+        self.fix(&now.key);
+        Event {
+            t,
+            kind: table.event_kind(f),
+            a: me,
+            b: f,
+        }
+    }
+
+    /// This ball (number `me`) and ball `other_id`, on `other`, in the order of their numbers:
+    /// the order in which every computation about the pair runs, so that both get one answer.
+    #[inline]
+    pub fn by_number<'a>(
+        &'a self,
+        me: u32,
+        other_id: u32,
+        other: &'a BallInfo,
+    ) -> (&'a BallInfo, &'a BallInfo) {
+        if me < other_id {
+            (self, other)
+        } else {
+            (other, self)
+        }
+    }
+
+    /// The later of the keys at which this trajectory and `other` were fixed: the parent of an
+    /// instantaneous contact between the two balls.
+    #[inline]
+    pub fn later_fix<'a>(&'a self, other: &'a BallInfo) -> &'a Key {
+        if self.fixed > other.fixed {
+            &self.fixed
+        } else {
+            &other.fixed
+        }
+    }
+
     /// Turns ball `me` around at `now` (thesis 4.6, fig. 13). On the table it takes a position fix
     /// and reverses: `None`, its trajectory changed now. In a pocket it reverses the crossing it
     /// dropped in by and returns the key at which it comes back out (the mirror image in time).
@@ -377,6 +464,8 @@ impl Pool {
         Planned { partner, sent }
     }
 
+    /// A ball's batch: one handler per message; if its trajectory changed, it cancels the
+    /// collisions it planned and tells every other object.
     fn ball_batch(
         &self,
         ctx: &mut Ctx<'_, Pool>,
@@ -387,127 +476,22 @@ impl Pool {
     ) {
         let mut changed = false;
         for env in batch {
-            match &env.msg {
+            changed |= match &env.msg {
                 PoolMsg::Collision {
                     partner,
                     info: other,
-                } => {
-                    if info.pocket.is_some() {
-                        continue;
-                    }
-                    // the collision happens: if this ball scheduled it, it is no longer planned
-                    if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
-                        planned.swap_remove(k);
-                    }
-                    let now = ctx.now().clone();
-                    let t = now.t();
-                    let me_info = Arc::make_mut(info);
-                    let p = me_info.traj.at(t);
-                    let mut kind = None;
-                    if let Some(o) = other {
-                        let q = o.traj.at(t);
-                        let (v, _) = if me < *partner {
-                            let (a, b) = physics::ball_ball_velocities(
-                                p,
-                                me_info.traj.velocity,
-                                me_info.mass,
-                                q,
-                                o.traj.velocity,
-                                o.mass,
-                            );
-                            (a, b)
-                        } else {
-                            let (a, b) = physics::ball_ball_velocities(
-                                q,
-                                o.traj.velocity,
-                                o.mass,
-                                p,
-                                me_info.traj.velocity,
-                                me_info.mass,
-                            );
-                            (b, a)
-                        };
-                        me_info.traj.velocity = v;
-                        if me > *partner {
-                            kind = Some((EventKind::BallBall, *partner, me));
-                        }
-                    } else {
-                        match self.table.bounce(*partner, p, me_info.traj.velocity) {
-                            Some(v) => me_info.traj.velocity = v,
-                            None => {
-                                let Fixed::Pocket(k) = self.table.fixed(*partner) else {
-                                    unreachable!("only pockets swallow balls")
-                                };
-                                me_info.pocket = Some(k);
-                            }
-                        }
-                        kind = Some((self.table.event_kind(*partner), me, *partner));
-                    }
-                    me_info.traj.position = p;
-                    me_info.traj.t0 = t;
-                    me_info.fix(&now.key);
-                    changed = true;
-                    if let Some((kind, a, b)) = kind {
-                        ctx.emit(PoolOutput::Event(Event { t, kind, a, b }));
-                    }
-                }
-                PoolMsg::ReverseYourself => {
-                    let now = ctx.now().clone();
-                    match Arc::make_mut(info).reverse(me, &now, &self.table) {
-                        None => changed = true,
-                        Some(back) => {
-                            ctx.send_at(me, VTime::at(back), PoolMsg::ReturnToTable);
-                        }
-                    }
-                }
-                PoolMsg::DisplayYourself => {
-                    let t = ctx.now().t();
-                    let mut state = (**info).clone();
-                    if state.pocket.is_none() {
-                        state.traj.position = state.traj.at(t);
-                        state.traj.t0 = t;
-                    }
-                    ctx.emit(PoolOutput::Draw { t, ball: me, state });
-                }
-                PoolMsg::ReturnToTable => {
-                    let now = ctx.now().clone();
-                    let ev = Arc::make_mut(info).come_back(me, &now, &self.table);
-                    changed = true;
-                    ctx.emit(PoolOutput::Event(ev));
-                }
+                } => self.on_collision(ctx, me, info, planned, *partner, other.as_deref()),
                 PoolMsg::NewVelocity(x) => {
-                    let from = env.from;
-                    cancel_with(ctx, planned, from);
-                    if info.pocket.is_some() || x.pocket.is_some() {
-                        continue;
-                    }
-                    // both changed at one key: the higher-numbered ball schedules the pair
-                    if x.fixed == info.fixed && from > me {
-                        continue;
-                    }
-                    let (lo, hi) = if me < from {
-                        (&**info, &**x)
-                    } else {
-                        (&**x, &**info)
-                    };
-                    let contact =
-                        physics::ball_ball_contact(&lo.traj, lo.radius, &hi.traj, hi.radius);
-                    let now = ctx.now().clone();
-                    let parent = if info.fixed > x.fixed {
-                        &info.fixed
-                    } else {
-                        &x.fixed
-                    };
-                    let closing = || overlapping_and_closing(lo, hi, now.t());
-                    if let Some(key) =
-                        self.contact_key(&now, contact, parent, pair(me, from), closing)
-                    {
-                        let p =
-                            Self::schedule(ctx, me, from, key, Some(info.clone()), Some(x.clone()));
-                        planned.push(p);
-                    }
+                    self.on_new_velocity(ctx, me, info, planned, env.from, x);
+                    false
                 }
-            }
+                PoolMsg::ReverseYourself => self.on_reverse(ctx, me, info),
+                PoolMsg::ReturnToTable => self.on_return(ctx, me, info),
+                PoolMsg::DisplayYourself => {
+                    Self::on_display(ctx, me, info);
+                    false
+                }
+            };
         }
         if changed {
             for p in planned.drain(..) {
@@ -516,6 +500,97 @@ impl Pool {
             let n = self.n_objects();
             self.broadcast(ctx, me, info, (0..n).filter(|&o| o != me));
         }
+    }
+
+    /// Collision: ball `me` meets ball `partner` (whose trajectory the message carries) or fixed
+    /// object `partner` now, unless it lies in a pocket. Whether its trajectory changed.
+    #[inline]
+    fn on_collision(
+        &self,
+        ctx: &mut Ctx<'_, Pool>,
+        me: u32,
+        info: &mut Arc<BallInfo>,
+        planned: &mut Vec<Planned>,
+        partner: u32,
+        other: Option<&BallInfo>,
+    ) -> bool {
+        if info.pocket.is_some() {
+            return false;
+        }
+        // the collision happens: if this ball scheduled it, it is no longer planned
+        if let Some(k) = planned.iter().position(|p| p.partner == partner) {
+            planned.swap_remove(k);
+        }
+        let now = ctx.now().clone();
+        let me_info = Arc::make_mut(info);
+        let event = match other {
+            Some(o) => me_info.collide(me, partner, o, &now),
+            None => Some(me_info.hit(me, partner, &self.table, &now)),
+        };
+        if let Some(event) = event {
+            ctx.emit(PoolOutput::Event(event));
+        }
+        true
+    }
+
+    /// NewVelocity: ball `from` has trajectory `x` now. Ball `me` cancels the collision it planned
+    /// with it and plans their next one, if they meet; when both changed at one key (they just
+    /// collided), the higher-numbered ball plans the pair.
+    #[inline]
+    fn on_new_velocity(
+        &self,
+        ctx: &mut Ctx<'_, Pool>,
+        me: u32,
+        info: &Arc<BallInfo>,
+        planned: &mut Vec<Planned>,
+        from: u32,
+        x: &Arc<BallInfo>,
+    ) {
+        cancel_with(ctx, planned, from);
+        if info.pocket.is_some() || x.pocket.is_some() || (x.fixed == info.fixed && from > me) {
+            return;
+        }
+        let (lo, hi) = info.by_number(me, from, x);
+        let contact = physics::ball_ball_contact(&lo.traj, lo.radius, &hi.traj, hi.radius);
+        let now = ctx.now().clone();
+        let closing = || overlapping_and_closing(lo, hi, now.t());
+        let parent = info.later_fix(x);
+        if let Some(key) = self.contact_key(&now, contact, parent, pair(me, from), closing) {
+            let p = Self::schedule(ctx, me, from, key, Some(info.clone()), Some(x.clone()));
+            planned.push(p);
+        }
+    }
+
+    /// ReverseYourself: ball `me` turns around (thesis 4.6). Whether its trajectory changed now
+    /// (not so in a pocket: it comes back out later, by a ReturnToTable to itself).
+    fn on_reverse(&self, ctx: &mut Ctx<'_, Pool>, me: u32, info: &mut Arc<BallInfo>) -> bool {
+        let now = ctx.now().clone();
+        match Arc::make_mut(info).reverse(me, &now, &self.table) {
+            None => true,
+            Some(back) => {
+                ctx.send_at(me, VTime::at(back), PoolMsg::ReturnToTable);
+                false
+            }
+        }
+    }
+
+    /// ReturnToTable: pocketed ball `me` comes back out now; its trajectory changed.
+    fn on_return(&self, ctx: &mut Ctx<'_, Pool>, me: u32, info: &mut Arc<BallInfo>) -> bool {
+        let now = ctx.now().clone();
+        let event = Arc::make_mut(info).come_back(me, &now, &self.table);
+        ctx.emit(PoolOutput::Event(event));
+        true
+    }
+
+    /// DisplayYourself: ball `me` draws itself where it is now (thesis 4.2).
+    fn on_display(ctx: &mut Ctx<'_, Pool>, me: u32, info: &BallInfo) {
+        let t = ctx.now().t();
+        let mut state = info.clone();
+        if state.pocket.is_none() {
+            state.traj.position = state.traj.at(t);
+            state.traj.t0 = t;
+        }
+        ctx.emit(PoolOutput::Draw { t, ball: me, state });
     }
 
     fn fixed_batch(

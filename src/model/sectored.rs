@@ -34,8 +34,7 @@ use super::layout::near_fixed;
 pub use super::layout::{FixedNews, Layout};
 use super::pool::{cancel_with, BallInfo, Planned, Plans};
 use super::MessageKind;
-use crate::engine::{Event, EventKind, Fixed, Span, Table};
-use crate::geometry::Trajectory;
+use crate::engine::{Event, Span, Table};
 use crate::physics::{self, Contact};
 use crate::polygon;
 use crate::scenario::{BallSpec, Scenario};
@@ -242,6 +241,31 @@ impl Clone for SecState {
     }
 }
 
+/// A ball's state while it handles one batch of messages, and what the batch has done so far.
+struct BallTurn<'s> {
+    me: u32,
+    info: &'s mut Arc<BallInfo>,
+    planned: &'s mut Vec<Planned>,
+    sectors: &'s mut Sectors,
+    awaiting: &'s mut Vec<(u32, bool)>,
+    /// The balls heard from (by a collision or a new trajectory): once a batch is enough.
+    heard: Vec<u32>,
+    /// Whether the trajectory changed.
+    changed: bool,
+}
+
+impl BallTurn<'_> {
+    /// Whether this is the batch's first word from `ball` (and notes it).
+    #[inline]
+    fn first_from(&mut self, ball: u32) -> bool {
+        let first = !self.heard.contains(&ball);
+        if first {
+            self.heard.push(ball);
+        }
+        first
+    }
+}
+
 /// The sectored pool model.
 pub struct Sectored {
     table: Table,
@@ -420,234 +444,190 @@ impl Sectored {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// A ball's batch: one handler per message; then, if its trajectory changed, it cancels
+    /// the collisions it planned and tells its sectors and the fixed objects within reach.
     fn ball_batch(
         &self,
         ctx: &mut Ctx<'_, Sectored>,
-        me: u32,
-        info: &mut Arc<BallInfo>,
-        planned: &mut Vec<Planned>,
-        sectors: &mut Sectors,
-        awaiting: &mut Vec<(u32, bool)>,
+        mut turn: BallTurn<'_>,
         batch: &[Envelope<SecMsg>],
     ) {
-        let mut changed = false;
-        let mut seen_balls: Vec<u32> = Vec::new();
         // the fixed objects that know the trajectory already, when the ball may enter sectors
         let entering = batch
             .iter()
             .any(|e| matches!(e.msg, SecMsg::SectorEntry { .. }));
-        let knew = entering.then(|| self.fixed_near(sectors));
+        let knew = entering.then(|| self.fixed_near(turn.sectors));
         for env in batch {
             match &env.msg {
                 SecMsg::Collision {
                     partner,
                     info: other,
                     seen,
-                } => {
-                    if seen_balls.contains(partner) {
-                        continue; // scheduled twice: once is enough
-                    }
-                    seen_balls.push(*partner);
-                    if let Some(k) = planned.iter().position(|p| p.partner == *partner) {
-                        planned.swap_remove(k);
-                    }
-                    let valid = info.version == *seen && info.pocket.is_none();
-                    if other.is_some() {
-                        ctx.send_now(
-                            *partner,
-                            SecMsg::CollisionConfirm {
-                                valid,
-                                info: info.clone(),
-                            },
-                        );
-                        awaiting.push((*partner, valid));
-                    } else if valid {
-                        self.hit_fixed(ctx, me, info, *partner);
-                        changed = true;
-                    }
-                }
+                } => self.on_collision(ctx, &mut turn, *partner, other.is_some(), *seen),
                 SecMsg::CollisionConfirm { valid, info: other } => {
-                    let Some(k) = awaiting.iter().position(|a| a.0 == env.from) else {
-                        continue;
-                    };
-                    let (partner, mine) = awaiting.swap_remove(k);
-                    if mine && *valid {
-                        self.hit_ball(ctx, me, info, partner, other);
-                        changed = true;
-                    }
+                    Self::on_confirm(ctx, &mut turn, env.from, *valid, other)
                 }
                 SecMsg::NewVelocity { ball, info: x } => {
-                    if seen_balls.contains(ball) {
-                        continue;
-                    }
-                    seen_balls.push(*ball);
-                    cancel_with(ctx, planned, *ball);
-                    if info.pocket.is_some() || x.pocket.is_some() {
-                        continue;
-                    }
-                    if x.fixed == info.fixed && x.fixed == ctx.now().key && *ball > me {
-                        continue; // both changed at this key: the higher-numbered ball schedules
-                    }
-                    let (lo, hi) = if me < *ball {
-                        (&**info, &**x)
-                    } else {
-                        (&**x, &**info)
-                    };
-                    let contact =
-                        physics::ball_ball_contact(&lo.traj, lo.radius, &hi.traj, hi.radius);
-                    let parent = if info.fixed > x.fixed {
-                        &info.fixed
-                    } else {
-                        &x.fixed
-                    };
-                    if let Some(key) = Self::key_of(contact, parent, pair(me, *ball)) {
-                        let p = Self::schedule(
-                            ctx,
-                            me,
-                            *ball,
-                            key,
-                            Some(info.clone()),
-                            info.version,
-                            Some(x.clone()),
-                            x.version,
-                        );
-                        planned.push(p);
-                    }
+                    Self::on_new_velocity(ctx, &mut turn, *ball, x)
                 }
-                SecMsg::ReverseYourself => {
-                    let now = ctx.now().clone();
-                    match Arc::make_mut(info).reverse(me, &now, &self.table) {
-                        None => changed = true,
-                        Some(back) => {
-                            ctx.send_at(me, VTime::at(back), SecMsg::ReturnToTable);
-                        }
-                    }
-                }
-                SecMsg::ReturnToTable => {
-                    let now = ctx.now().clone();
-                    let ev = Arc::make_mut(info).come_back(me, &now, &self.table);
-                    let first = self.first_sector();
-                    *sectors = self
-                        .layout
-                        .touching(info.traj.position, info.radius)
-                        .into_iter()
-                        .map(|s| first + s)
-                        .collect();
-                    changed = true;
-                    ctx.emit(ev);
-                }
+                SecMsg::ReverseYourself => self.on_reverse(ctx, &mut turn),
+                SecMsg::ReturnToTable => self.on_return(ctx, &mut turn),
                 SecMsg::SectorEntry { sector, .. } => {
-                    if !sectors.contains(sector) {
-                        sectors.push(*sector);
+                    if !turn.sectors.contains(sector) {
+                        turn.sectors.push(*sector);
                     }
                 }
-                SecMsg::SectorDeparture { sector, .. } => sectors.retain(|s| s != sector),
+                SecMsg::SectorDeparture { sector, .. } => turn.sectors.retain(|s| s != sector),
                 SecMsg::VelocityChange { .. } | SecMsg::VelocityInitialization { .. } => {
                     unreachable!("balls are not told of velocity changes by balls")
                 }
             }
         }
-        if changed {
-            for p in planned.drain(..) {
-                p.cancel(ctx);
-            }
-            for &s in sectors.iter() {
-                ctx.send_now(
-                    s,
-                    SecMsg::VelocityChange {
-                        ball: me,
-                        info: info.clone(),
-                    },
-                );
-            }
-            self.tell_fixed(ctx, me, info, sectors);
-            if info.pocket.is_some() {
-                sectors.clear();
-            }
+        if turn.changed {
+            self.tell_change(ctx, turn);
         } else if let Some(knew) = knew {
             // a fixed object newly in reach hears of the trajectory on entry
-            let mut now_near = self.fixed_near(sectors);
+            let mut now_near = self.fixed_near(turn.sectors);
             now_near.retain(|f| knew.binary_search(f).is_err());
-            self.tell(ctx, me, info, &now_near);
+            self.tell(ctx, turn.me, turn.info, &now_near);
         }
     }
 
-    /// Ball `me` collides with ball `partner` (on trajectory `other`) now.
-    fn hit_ball(
+    /// Collision with `partner`, predicted from the ball's trajectory of version `seen`. Against
+    /// a fixed object it happens now if that trajectory still holds; against a ball (`with_ball`)
+    /// both first confirm, by a CollisionConfirm each, that their trajectories still hold.
+    #[inline]
+    fn on_collision(
         &self,
         ctx: &mut Ctx<'_, Sectored>,
-        me: u32,
-        info: &mut Arc<BallInfo>,
+        turn: &mut BallTurn<'_>,
         partner: u32,
-        other: &BallInfo,
+        with_ball: bool,
+        seen: u64,
     ) {
-        let now = ctx.now().clone();
-        let t = now.t();
-        let me_info = Arc::make_mut(info);
-        let p = me_info.traj.at(t);
-        let q = other.traj.at(t);
-        let v = if me < partner {
-            physics::ball_ball_velocities(
-                p,
-                me_info.traj.velocity,
-                me_info.mass,
-                q,
-                other.traj.velocity,
-                other.mass,
-            )
-            .0
-        } else {
-            physics::ball_ball_velocities(
-                q,
-                other.traj.velocity,
-                other.mass,
-                p,
-                me_info.traj.velocity,
-                me_info.mass,
-            )
-            .1
-        };
-        me_info.traj = Trajectory {
-            position: p,
-            velocity: v,
-            t0: t,
-        };
-        me_info.fix(&now.key);
-        if me > partner {
-            ctx.emit(Event {
-                t,
-                kind: EventKind::BallBall,
-                a: partner,
-                b: me,
-            });
+        if !turn.first_from(partner) {
+            return; // scheduled twice: once is enough
+        }
+        if let Some(k) = turn.planned.iter().position(|p| p.partner == partner) {
+            turn.planned.swap_remove(k);
+        }
+        let valid = turn.info.version == seen && turn.info.pocket.is_none();
+        if with_ball {
+            let info = turn.info.clone();
+            ctx.send_now(partner, SecMsg::CollisionConfirm { valid, info });
+            turn.awaiting.push((partner, valid));
+        } else if valid {
+            let now = ctx.now().clone();
+            let event = Arc::make_mut(turn.info).hit(turn.me, partner, &self.table, &now);
+            ctx.emit(event);
+            turn.changed = true;
         }
     }
 
-    /// Ball `me` hits fixed object `f` now.
-    fn hit_fixed(&self, ctx: &mut Ctx<'_, Sectored>, me: u32, info: &mut Arc<BallInfo>, f: u32) {
+    /// CollisionConfirm from ball `from`, on trajectory `other`: the collision happens now if
+    /// both trajectories still hold.
+    #[inline]
+    fn on_confirm(
+        ctx: &mut Ctx<'_, Sectored>,
+        turn: &mut BallTurn<'_>,
+        from: u32,
+        valid: bool,
+        other: &BallInfo,
+    ) {
+        let Some(k) = turn.awaiting.iter().position(|a| a.0 == from) else {
+            return;
+        };
+        let (partner, mine) = turn.awaiting.swap_remove(k);
+        if mine && valid {
+            let now = ctx.now().clone();
+            if let Some(event) = Arc::make_mut(turn.info).collide(turn.me, partner, other, &now) {
+                ctx.emit(event);
+            }
+            turn.changed = true;
+        }
+    }
+
+    /// NewVelocity: ball `ball` has trajectory `x` now. The ball cancels the collision it planned
+    /// with it and plans their next one, if they meet; when both changed at this key, the
+    /// higher-numbered ball plans the pair.
+    #[inline]
+    fn on_new_velocity(
+        ctx: &mut Ctx<'_, Sectored>,
+        turn: &mut BallTurn<'_>,
+        ball: u32,
+        x: &Arc<BallInfo>,
+    ) {
+        if !turn.first_from(ball) {
+            return;
+        }
+        let (me, info) = (turn.me, &*turn.info);
+        cancel_with(ctx, turn.planned, ball);
+        if info.pocket.is_some() || x.pocket.is_some() {
+            return;
+        }
+        if x.fixed == info.fixed && x.fixed == ctx.now().key && ball > me {
+            return; // both changed at this key: the higher-numbered ball schedules
+        }
+        let (lo, hi) = info.by_number(me, ball, x);
+        let contact = physics::ball_ball_contact(&lo.traj, lo.radius, &hi.traj, hi.radius);
+        if let Some(key) = Self::key_of(contact, info.later_fix(x), pair(me, ball)) {
+            let mine = Some(info.clone());
+            let p = Self::schedule(
+                ctx,
+                me,
+                ball,
+                key,
+                mine,
+                info.version,
+                Some(x.clone()),
+                x.version,
+            );
+            turn.planned.push(p);
+        }
+    }
+
+    /// ReverseYourself: the ball turns around (thesis 4.6); in a pocket it comes back out later,
+    /// by a ReturnToTable to itself.
+    fn on_reverse(&self, ctx: &mut Ctx<'_, Sectored>, turn: &mut BallTurn<'_>) {
         let now = ctx.now().clone();
-        let t = now.t();
-        let me_info = Arc::make_mut(info);
-        let p = me_info.traj.at(t);
-        match self.table.bounce(f, p, me_info.traj.velocity) {
-            Some(v) => me_info.traj.velocity = v,
-            None => {
-                let Fixed::Pocket(k) = self.table.fixed(f) else {
-                    unreachable!("only pockets swallow balls")
-                };
-                me_info.pocket = Some(k);
+        match Arc::make_mut(turn.info).reverse(turn.me, &now, &self.table) {
+            None => turn.changed = true,
+            Some(back) => {
+                ctx.send_at(turn.me, VTime::at(back), SecMsg::ReturnToTable);
             }
         }
-        me_info.traj.position = p;
-        me_info.traj.t0 = t;
-        me_info.fix(&now.key);
-        ctx.emit(Event {
-            t,
-            kind: self.table.event_kind(f),
-            a: me,
-            b: f,
-        });
+    }
+
+    /// ReturnToTable: the pocketed ball comes back out now, into the sectors its disk touches.
+    fn on_return(&self, ctx: &mut Ctx<'_, Sectored>, turn: &mut BallTurn<'_>) {
+        let now = ctx.now().clone();
+        let event = Arc::make_mut(turn.info).come_back(turn.me, &now, &self.table);
+        let first = self.first_sector();
+        *turn.sectors = self
+            .layout
+            .touching(turn.info.traj.position, turn.info.radius)
+            .into_iter()
+            .map(|s| first + s)
+            .collect();
+        turn.changed = true;
+        ctx.emit(event);
+    }
+
+    /// The ball's trajectory changed: it cancels the collisions it planned and tells its sectors
+    /// (which relay it to their balls) and the fixed objects within reach.
+    fn tell_change(&self, ctx: &mut Ctx<'_, Sectored>, turn: BallTurn<'_>) {
+        let (me, info) = (turn.me, &*turn.info);
+        for p in turn.planned.drain(..) {
+            p.cancel(ctx);
+        }
+        for &s in turn.sectors.iter() {
+            let info = info.clone();
+            ctx.send_now(s, SecMsg::VelocityChange { ball: me, info });
+        }
+        self.tell_fixed(ctx, me, info, turn.sectors);
+        if info.pocket.is_some() {
+            turn.sectors.clear();
+        }
     }
 
     fn fixed_batch(
@@ -943,7 +923,18 @@ impl Model for Sectored {
                 planned,
                 sectors,
                 awaiting,
-            } => self.ball_batch(ctx, me, info, planned, sectors, awaiting, batch),
+            } => {
+                let turn = BallTurn {
+                    me,
+                    info,
+                    planned,
+                    sectors,
+                    awaiting,
+                    heard: Vec::new(),
+                    changed: false,
+                };
+                self.ball_batch(ctx, turn, batch)
+            }
             SecState::Fixed { planned } => self.fixed_batch(ctx, me, planned, batch),
             SecState::Sector { members, planned } => {
                 self.sector_batch(ctx, me, members, planned, batch)
