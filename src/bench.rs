@@ -416,7 +416,7 @@ fn measure_phold(
             final_batches: !a.tw_pure,
             ..Default::default()
         });
-        let p = pdes_kernel::phold::run(phold_cfg.clone(), 20.0, tw)?;
+        let p = pdes_kernel::phold::run(phold_cfg.clone(), 20.0, tw).map_err(|e| e.to_string())?;
         if let Some(first) = phold
             .first()
             .filter(|f| f.final_state_digest != p.final_state_digest)
