@@ -466,7 +466,7 @@ pub fn measure_objects(
     let start = Instant::now();
     if let Some(choice) = sectors {
         scenario.until = SECTORED_WARM_UP + SECTORED_WINDOW;
-        let layout = crate::run::sector_layout(&scenario, choice)?;
+        let layout = crate::run::sector_layout(&scenario, choice).map_err(|e| e.to_string())?;
         let mut engine =
             crate::engine::objects::Objects::sectored(&scenario, layout, Default::default());
         let sent =

@@ -359,7 +359,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
     let drawn = match (cfg.sectors, cfg.engine) {
         (None, _) => None,
         (Some(_), EngineKind::Sectored { sectors, .. }) | (Some(sectors), _) => {
-            Some(sector_layout(scenario, sectors).map_err(RunError::Input)?)
+            Some(sector_layout(scenario, sectors)?)
         }
     };
     let sectored = matches!(cfg.engine, EngineKind::Sectored { .. });
