@@ -46,23 +46,17 @@ impl ModelParams {
 
     /// Checks the parameters: `N`, `V` and `T` finite and positive, `m` finite and not negative.
     /// The error names the command-line option.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ModelError> {
         if !(self.balls >= 1.0 && self.balls <= MAX_BALLS && self.balls.fract() == 0.0) {
-            return Err(format!(
-                "--balls must be a whole number from 1 to {MAX_BALLS:e}, got {:?}",
-                self.balls
-            ));
+            return Err(ModelError::Balls(self.balls));
         }
-        for (name, x) in [("--speed", self.speed), ("--time", self.time)] {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(format!("{name} must be a positive number, got {x:?}"));
+        for (flag, value) in [("--speed", self.speed), ("--time", self.time)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(ModelError::NotPositive { flag, value });
             }
         }
         if !(self.changes.is_finite() && self.changes >= 0.0) {
-            return Err(format!(
-                "--changes must be a number not below 0, got {}",
-                self.changes
-            ));
+            return Err(ModelError::Changes(self.changes));
         }
         // F is largest at the ends of the widths reported: one sector, and the finest grid
         let finest = 1.0
@@ -70,11 +64,7 @@ impl ModelParams {
                 .ceil()
                 .max(8.0);
         if !(messages(self, 1.0).is_finite() && messages(self, finest).is_finite()) {
-            return Err(format!(
-                "the message counts overflow a 64-bit float for N = {:?}, V = {:?}, T = {:?}, \
-                 m = {:?}",
-                self.balls, self.speed, self.time, self.changes
-            ));
+            return Err(ModelError::Overflow(*self));
         }
         Ok(())
     }
@@ -87,6 +77,32 @@ impl ModelParams {
             2
         }
     }
+}
+
+/// Why [`ModelParams`] are refused ([`ModelParams::validate`]); the message names the
+/// command-line option.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ModelError {
+    /// `N` is not a whole number from 1 to [`MAX_BALLS`].
+    #[error("--balls must be a whole number from 1 to {MAX_BALLS:e}, got {0:?}")]
+    Balls(f64),
+    /// `V` or `T` is not a finite positive number.
+    #[error("{flag} must be a positive number, got {value:?}")]
+    NotPositive {
+        /// The option: `--speed` or `--time`.
+        flag: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// `m` is negative or not finite.
+    #[error("--changes must be a number not below 0, got {0}")]
+    Changes(f64),
+    /// The message counts are too large for a 64-bit float.
+    #[error(
+        "the message counts overflow a 64-bit float for N = {:?}, V = {:?}, T = {:?}, m = {:?}",
+        .0.balls, .0.speed, .0.time, .0.changes
+    )]
+    Overflow(ModelParams),
 }
 
 /// The most balls the model takes: its table of grids then stays at a few dozen rows.
@@ -283,7 +299,7 @@ pub fn report(p: &ModelParams) -> String {
 /// with `params` and `error`.
 pub fn report_json(p: &ModelParams) -> Value {
     if let Err(e) = p.validate() {
-        return json!({ "model": "goldberg-1984-ch7", "params": p, "error": e });
+        return json!({ "model": "goldberg-1984-ch7", "params": p, "error": e.to_string() });
     }
     let s_opt = optimal_sector(p);
     let best = best_grid(p, s_opt);
@@ -424,7 +440,11 @@ mod tests {
         assert!(j["table"].as_array().unwrap().len() >= 8);
         assert_eq!(j["params"]["balls"], 64.0);
         let bad = ModelParams::new(0.0);
-        assert!(bad.validate().unwrap_err().contains("--balls"));
+        assert_eq!(bad.validate(), Err(ModelError::Balls(0.0)));
+        assert_eq!(
+            bad.validate().unwrap_err().to_string(),
+            "--balls must be a whole number from 1 to 1e15, got 0.0"
+        );
         assert!(optimal_sector(&bad).is_nan());
         assert!(report_json(&bad)["error"].is_string());
         assert!(report(&bad).contains("invalid parameters"));

@@ -8,9 +8,11 @@
 //! number of events on one thread.
 
 use crate::engine::event_list::{EventList, Options};
-use crate::engine::Ignore;
+use crate::engine::{Ignore, RunError};
+use crate::run::SectorLayoutError;
 use crate::scenario::builtin::{self, Params};
-use pdes_kernel::phold::{PholdConfig, PholdReport, ROSS_EVENTS_PER_SECOND_PER_CORE};
+use crate::scenario::Invalid;
+use pdes_kernel::phold::{PholdConfig, PholdError, PholdReport, ROSS_EVENTS_PER_SECOND_PER_CORE};
 use std::time::Instant;
 
 /// What `poolsim bench` measures.
@@ -84,12 +86,95 @@ pub enum Measured<'a> {
     Phold(&'a PholdReport),
 }
 
+/// Why `poolsim bench` stopped: a bad option (the message names its flag), or a run that failed
+/// or disagreed with the sequential one.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// An area fraction outside (0, 1).
+    #[error("--area-fractions: each must lie in (0, 1), got {0}")]
+    AreaFraction(f64),
+    /// No repeats.
+    #[error("--repeat: must be at least 1")]
+    Repeat,
+    /// A ball count of 0.
+    #[error("{flag}: each ball count must be at least 1")]
+    NoBalls {
+        /// The flag of the list.
+        flag: &'static str,
+    },
+    /// No events to measure.
+    #[error("--events: must be at least 1")]
+    Events,
+    /// No worker counts, or a count of 0.
+    #[error("--tw-workers: each worker count must be at least 1")]
+    Workers,
+    /// Fewer PHOLD objects than partitions.
+    #[error(
+        "--phold-objects: PHOLD runs on {partitions} partitions here, so it needs at least \
+         {partitions} objects, got {objects}"
+    )]
+    PholdObjects {
+        /// The partitions PHOLD runs on.
+        partitions: usize,
+        /// The objects asked for.
+        objects: u32,
+    },
+    /// A grid cell narrower than a ball.
+    #[error("--cell-diameters: a cell must be at least one ball diameter wide, got {0:?}")]
+    CellDiameters(f64),
+    /// A simulated time of the Time Warp runs that is not positive.
+    #[error("--tw-until: must be a positive simulated time, got {0}")]
+    TwUntil(f64),
+    /// The gas could not be built.
+    #[error("{}: {}", .0.field, .0.message)]
+    Scenario(Invalid),
+    /// The sector layout could not be built.
+    #[error(transparent)]
+    Layout(#[from] SectorLayoutError),
+    /// A run of the pool failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A PHOLD run failed.
+    #[error(transparent)]
+    Phold(#[from] PholdError),
+    /// PHOLD under Time Warp ended in another state than on the sequential kernel.
+    #[error(
+        "bench: PHOLD under Time Warp on {workers} workers ended in state {digest}, on the \
+         sequential kernel in {sequential}"
+    )]
+    PholdDigest {
+        /// The workers (0: none).
+        workers: usize,
+        /// Its final state digest.
+        digest: String,
+        /// The sequential kernel's.
+        sequential: String,
+    },
+    /// Time Warp ended in another state than the sequential objects engine.
+    #[error(
+        "bench: Time Warp on {workers} workers ended in state {digest}, the sequential engine \
+         in {sequential} ({balls} balls until {until})"
+    )]
+    TimeWarpDigest {
+        /// The workers.
+        workers: usize,
+        /// Its final state digest.
+        digest: String,
+        /// The sequential engine's.
+        sequential: String,
+        /// Balls of the gas.
+        balls: usize,
+        /// Simulated time of the run.
+        until: f64,
+    },
+}
+
 /// The fastest of `n` (at least one) runs of `f`, by the seconds `secs` reads off each result.
-fn fastest<T>(
+fn fastest<T, E>(
     n: u32,
     secs: impl Fn(&T) -> f64,
-    mut f: impl FnMut() -> Result<T, String>,
-) -> Result<T, String> {
+    mut f: impl FnMut() -> Result<T, E>,
+) -> Result<T, E> {
     let mut best = f()?;
     for _ in 1..n {
         let r = f()?;
@@ -234,7 +319,7 @@ fn proc_status_mib(field: &str) -> f64 {
 fn thesis_gas(
     balls: usize,
     area_fraction: Option<f64>,
-) -> Result<(usize, crate::scenario::Scenario), String> {
+) -> Result<(usize, crate::scenario::Scenario), BenchError> {
     let k = ((balls as f64).sqrt().round() as usize).max(1);
     let params = Params {
         balls: Some(k * k),
@@ -242,8 +327,7 @@ fn thesis_gas(
         area_fraction,
         ..Params::default()
     };
-    let scenario =
-        builtin::build("gas", &params).map_err(|e| format!("{}: {}", e.field, e.message))?;
+    let scenario = builtin::build("gas", &params).map_err(BenchError::Scenario)?;
     Ok((k * k, scenario))
 }
 
@@ -253,7 +337,7 @@ pub fn measure(
     area_fraction: f64,
     events: u64,
     cell_diameters: f64,
-) -> Result<BenchRow, String> {
+) -> Result<BenchRow, BenchError> {
     let start = Instant::now();
     let (n_balls, scenario) = thesis_gas(balls, Some(area_fraction))?;
     let opts = Options {
@@ -264,9 +348,7 @@ pub fn measure(
     let setup = start.elapsed().as_secs_f64();
     let target = events.max(5 * n_balls as u64);
     let start = Instant::now();
-    let out = engine
-        .run_for(f64::INFINITY, target, &mut Ignore)
-        .map_err(|e| e.to_string())?;
+    let out = engine.run_for(f64::INFINITY, target, &mut Ignore)?;
     let secs = start.elapsed().as_secs_f64();
     let n = out.events.total();
     Ok(BenchRow {
@@ -282,16 +364,14 @@ pub fn measure(
 }
 
 /// Checks the options; errors name the command line's flag.
-fn validate(a: &BenchOptions) -> Result<usize, String> {
+fn validate(a: &BenchOptions) -> Result<usize, BenchError> {
     for &phi in &a.area_fractions {
         if !(phi > 0.0 && phi < 1.0) {
-            return Err(format!(
-                "--area-fractions: each must lie in (0, 1), got {phi}"
-            ));
+            return Err(BenchError::AreaFraction(phi));
         }
     }
     if a.repeat == 0 {
-        return Err("--repeat: must be at least 1".into());
+        return Err(BenchError::Repeat);
     }
     for (flag, counts) in [
         ("--balls", &a.balls),
@@ -300,40 +380,33 @@ fn validate(a: &BenchOptions) -> Result<usize, String> {
         ("--tw-balls", &a.tw_balls),
     ] {
         if counts.contains(&0) {
-            return Err(format!("{flag}: each ball count must be at least 1"));
+            return Err(BenchError::NoBalls { flag });
         }
     }
     if a.events == 0 {
-        return Err("--events: must be at least 1".into());
+        return Err(BenchError::Events);
     }
     if a.tw_workers.is_empty() || a.tw_workers.contains(&0) {
-        return Err("--tw-workers: each worker count must be at least 1".into());
+        return Err(BenchError::Workers);
     }
     let partitions = a.tw_workers.iter().copied().max().unwrap_or(2).max(2);
     if (a.phold_objects as usize) < partitions {
-        return Err(format!(
-            "--phold-objects: PHOLD runs on {partitions} partitions here, so it needs at least \
-             {partitions} objects, got {}",
-            a.phold_objects
-        ));
+        return Err(BenchError::PholdObjects {
+            partitions,
+            objects: a.phold_objects,
+        });
     }
     if !(a.cell_diameters.is_finite() && a.cell_diameters >= 1.0) {
-        return Err(format!(
-            "--cell-diameters: a cell must be at least one ball diameter wide, got {:?}",
-            a.cell_diameters
-        ));
+        return Err(BenchError::CellDiameters(a.cell_diameters));
     }
     if !(a.tw_until.is_finite() && a.tw_until > 0.0) {
-        return Err(format!(
-            "--tw-until: must be a positive simulated time, got {}",
-            a.tw_until
-        ));
+        return Err(BenchError::TwUntil(a.tw_until));
     }
     Ok(partitions)
 }
 
 /// Measures everything `a` asks for, handing each result to `each` as soon as it is measured.
-pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchReport, String> {
+pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchReport, BenchError> {
     let partitions = validate(a)?;
     let mut rows = Vec::new();
     for &n in &a.balls {
@@ -399,7 +472,7 @@ fn measure_phold(
     a: &BenchOptions,
     partitions: u32,
     each: &mut dyn FnMut(Measured),
-) -> Result<Vec<PholdReport>, String> {
+) -> Result<Vec<PholdReport>, BenchError> {
     let phold_cfg = PholdConfig {
         objects: a.phold_objects,
         events_per_object: 16,
@@ -421,13 +494,11 @@ fn measure_phold(
             .first()
             .filter(|f| f.final_state_digest != p.final_state_digest)
         {
-            return Err(format!(
-                "bench: PHOLD under Time Warp on {} workers ended in state {}, on the sequential \
-                 kernel in {}",
-                workers.unwrap_or(0),
-                p.final_state_digest,
-                first.final_state_digest
-            ));
+            return Err(BenchError::PholdDigest {
+                workers: workers.unwrap_or(0),
+                digest: p.final_state_digest,
+                sequential: first.final_state_digest.clone(),
+            });
         }
         each(Measured::Phold(&p));
         phold.push(p);
@@ -461,7 +532,7 @@ pub const SECTORED_WINDOW: f64 = 2.0;
 pub fn measure_objects(
     balls: usize,
     sectors: Option<crate::run::SectorChoice>,
-) -> Result<ObjectsRow, String> {
+) -> Result<ObjectsRow, BenchError> {
     let (n_balls, mut scenario) = thesis_gas(balls, sectors.map(|_| 0.3))?;
     let start = Instant::now();
     if let Some(choice) = sectors {
@@ -471,13 +542,9 @@ pub fn measure_objects(
             crate::engine::objects::Objects::sectored(&scenario, layout, Default::default());
         let sent =
             |out: &crate::engine::Outcome| -> u64 { out.messages.iter().map(|(_, c)| c).sum() };
-        let warm = engine
-            .run(SECTORED_WARM_UP, &mut Ignore)
-            .map_err(|e| e.to_string())?;
+        let warm = engine.run(SECTORED_WARM_UP, &mut Ignore)?;
         let measured = Instant::now();
-        let out = engine
-            .run(scenario.until, &mut Ignore)
-            .map_err(|e| e.to_string())?;
+        let out = engine.run(scenario.until, &mut Ignore)?;
         return Ok(ObjectsRow {
             balls: n_balls,
             events: out.events.total(),
@@ -490,9 +557,7 @@ pub fn measure_objects(
         crate::model::pool::NvDelay::Exact,
         Default::default(),
     );
-    let out = engine
-        .run(scenario.until, &mut Ignore)
-        .map_err(|e| e.to_string())?;
+    let out = engine.run(scenario.until, &mut Ignore)?;
     let seconds = start.elapsed().as_secs_f64();
     Ok(ObjectsRow {
         balls: n_balls,
@@ -542,7 +607,7 @@ pub fn measure_time_warp(
     until: f64,
     pure: bool,
     workers: &[usize],
-) -> Result<Vec<TwRow>, String> {
+) -> Result<Vec<TwRow>, BenchError> {
     crate::memory::transparent_huge_pages(false);
     let rows = time_warp_rows(balls, until, pure, workers);
     crate::memory::transparent_huge_pages(true);
@@ -554,7 +619,7 @@ fn time_warp_rows(
     until: f64,
     pure: bool,
     workers: &[usize],
-) -> Result<Vec<TwRow>, String> {
+) -> Result<Vec<TwRow>, BenchError> {
     use crate::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
     let (n_balls, scenario) = thesis_gas(balls, None)?;
     let mut rows: Vec<TwRow> = Vec::new();
@@ -581,17 +646,19 @@ fn time_warp_rows(
             check: false,
             span: Default::default(),
         };
-        let report = execute(&scenario, &cfg, &mut Ignore).map_err(|e| e.to_string())?;
+        let report = execute(&scenario, &cfg, &mut Ignore)?;
         let s = &report.summary;
         let tw = s.time_warp.as_ref();
         let digest = s.final_state_digest.clone();
         if let Some(first) = rows.first() {
             if first.digest != digest {
-                return Err(format!(
-                    "bench: Time Warp on {workers} workers ended in state {digest}, the \
-                     sequential engine in {} ({} balls until {until})",
-                    first.digest, n_balls
-                ));
+                return Err(BenchError::TimeWarpDigest {
+                    workers,
+                    digest,
+                    sequential: first.digest.clone(),
+                    balls: n_balls,
+                    until,
+                });
             }
         }
         let seconds = report.wall_seconds;
@@ -697,7 +764,7 @@ mod tests {
             |t: &f64| *t,
             || {
                 calls += 1;
-                Ok(times.next().unwrap())
+                Ok::<_, String>(times.next().unwrap())
             },
         );
         assert_eq!((best, calls), (Ok(1.0), 3));

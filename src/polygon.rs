@@ -54,7 +54,7 @@ impl Polygon {
     /// corner (a simple polygon). A closing point equal to the first, as in the thesis' corner lists
     /// (5.1: "the first corner repeats at the end"), is dropped. Points are counted from 1 in the
     /// messages.
-    pub fn new(points: Vec<Vec2>) -> Result<Polygon, String> {
+    pub fn new(points: Vec<Vec2>) -> Result<Polygon, PolygonError> {
         let mut points = points;
         if points.len() >= 2 && points.first() == points.last() {
             points.pop();
@@ -65,56 +65,45 @@ impl Polygon {
     }
 
     /// The checks of [`Polygon::new`] on an already built polygon.
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), PolygonError> {
         let pts = &self.points;
         let n = pts.len();
         if n < 3 {
-            return Err(format!(
-                "a polygon needs at least 3 distinct points, got {n}"
-            ));
+            return Err(PolygonError::TooFewPoints { count: n });
         }
-        for (k, p) in pts.iter().enumerate() {
+        for (k, &p) in pts.iter().enumerate() {
             if !p.is_finite() {
-                return Err(format!(
-                    "point {} must be two finite numbers, got [{}, {}]",
-                    k + 1,
-                    p.x,
-                    p.y
-                ));
+                return Err(PolygonError::NotFinite {
+                    point: k + 1,
+                    at: p,
+                });
             }
         }
         for k in 0..n {
             let (p, q) = (pts[k], pts[(k + 1) % n]);
             if p == q {
-                return Err(format!(
-                    "points {} and {} are the same point [{}, {}]",
-                    k + 1,
-                    (k + 1) % n + 1,
-                    p.x,
-                    p.y
-                ));
+                return Err(PolygonError::Repeated {
+                    point: k + 1,
+                    next: (k + 1) % n + 1,
+                    at: p,
+                });
             }
         }
         if pts.iter().all(|&c| orient(pts[0], pts[1], c) == 0) {
-            return Err("has zero area: all its points lie on one line".into());
+            return Err(PolygonError::Collinear);
         }
         if let Some((i, j)) = self.self_intersection() {
             return Err(if j == (i + 1) % n {
-                format!(
-                    "turns back on itself at point {} (the polygon must not intersect itself)",
-                    j + 1
-                )
+                PolygonError::TurnsBack { point: j + 1 }
             } else {
-                format!(
-                    "edges {} and {} meet (the polygon must not intersect itself; edge k runs \
-                     from point k to the next)",
-                    i + 1,
-                    j + 1
-                )
+                PolygonError::EdgesMeet {
+                    first: i + 1,
+                    second: j + 1,
+                }
             });
         }
         if self.signed_area() == 0.0 {
-            return Err("has zero area".into());
+            return Err(PolygonError::ZeroArea);
         }
         Ok(())
     }
@@ -303,6 +292,138 @@ pub fn grid(lo: Vec2, hi: Vec2, nx: u32, ny: u32) -> Vec<Polygon> {
     out
 }
 
+/// Why a list of points is not a simple polygon ([`Polygon::new`]). Points and edges are counted
+/// from 1, edge `k` running from point `k` to the next.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PolygonError {
+    /// Fewer than three points.
+    #[error("a polygon needs at least 3 distinct points, got {count}")]
+    TooFewPoints {
+        /// How many points there are.
+        count: usize,
+    },
+    /// A coordinate is infinite or not a number.
+    #[error("point {point} must be two finite numbers, got [{}, {}]", .at.x, .at.y)]
+    NotFinite {
+        /// Which point.
+        point: usize,
+        /// Its coordinates.
+        at: Vec2,
+    },
+    /// A point repeats its predecessor.
+    #[error("points {point} and {next} are the same point [{}, {}]", .at.x, .at.y)]
+    Repeated {
+        /// The first of the two.
+        point: usize,
+        /// The one after it (1 when `point` is the last).
+        next: usize,
+        /// Where they both are.
+        at: Vec2,
+    },
+    /// Every point lies on one line.
+    #[error("has zero area: all its points lie on one line")]
+    Collinear,
+    /// Two neighbouring edges fold back along each other.
+    #[error("turns back on itself at point {point} (the polygon must not intersect itself)")]
+    TurnsBack {
+        /// The corner where the boundary folds back.
+        point: usize,
+    },
+    /// Two edges that are not neighbours touch.
+    #[error(
+        "edges {first} and {second} meet (the polygon must not intersect itself; edge k runs \
+         from point k to the next)"
+    )]
+    EdgesMeet {
+        /// The lower-numbered edge.
+        first: usize,
+        /// The other edge.
+        second: usize,
+    },
+    /// The signed area is zero.
+    #[error("has zero area")]
+    ZeroArea,
+}
+
+/// Why polygons do not tile a table's box ([`validate_layout`]). Polygons are counted from 1, as
+/// `sectors.polygon[k]` in a scenario file.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LayoutError {
+    /// The table's box is empty, inverted or not finite.
+    #[error("the table's box [{}, {}] .. [{}, {}] has no area", .lo.x, .lo.y, .hi.x, .hi.y)]
+    NoArea {
+        /// The box's lower-left corner.
+        lo: Vec2,
+        /// Its upper-right corner.
+        hi: Vec2,
+    },
+    /// The list of polygons is empty.
+    #[error("there are no sectors: they leave all of the table's area uncovered")]
+    NoSectors,
+    /// A polygon is not a simple polygon.
+    #[error("sectors.polygon[{index}] {source}")]
+    Polygon {
+        /// Which polygon.
+        index: usize,
+        /// What is wrong with it.
+        #[source]
+        source: PolygonError,
+    },
+    /// A polygon has a corner outside the table's box.
+    #[error(
+        "sectors.polygon[{index}] reaches outside the table: point [{}, {}] is not in \
+         [{}, {}] .. [{}, {}]",
+        .point.x, .point.y, .lo.x, .lo.y, .hi.x, .hi.y
+    )]
+    Outside {
+        /// Which polygon.
+        index: usize,
+        /// Its corner outside.
+        point: Vec2,
+        /// The box's lower-left corner.
+        lo: Vec2,
+        /// Its upper-right corner.
+        hi: Vec2,
+    },
+    /// Two polygons have interiors in common.
+    #[error("sectors.polygon[{first}] overlaps sectors.polygon[{second}]")]
+    Overlap {
+        /// The lower-numbered polygon.
+        first: usize,
+        /// The other one.
+        second: usize,
+    },
+    /// The polygons' areas fall short of the table's.
+    #[error("the sectors leave {} of the table's area uncovered", short(*.missing))]
+    Uncovered {
+        /// The area left over (length²).
+        missing: f64,
+    },
+    /// The polygons' areas add up to more than the table's.
+    #[error(
+        "the sectors' areas add up to {}, more than the table's {}",
+        short(*.covered),
+        short(*.table)
+    )]
+    Overcovered {
+        /// The polygons' total area (length²).
+        covered: f64,
+        /// The table's area (length²).
+        table: f64,
+    },
+}
+
+impl LayoutError {
+    /// The first polygon the error names (counted from 1), if any: the one to blame.
+    pub fn polygon(&self) -> Option<usize> {
+        match *self {
+            LayoutError::Polygon { index, .. } | LayoutError::Outside { index, .. } => Some(index),
+            LayoutError::Overlap { first, .. } => Some(first),
+            _ => None,
+        }
+    }
+}
+
 /// Relative tolerance of [`validate_layout`]: lengths below this fraction of the table's larger
 /// side count as zero, so that sectors whose shared edges differ by rounding still fit.
 pub const LAYOUT_TOLERANCE: f64 = 1e-9;
@@ -320,34 +441,32 @@ pub const LAYOUT_TOLERANCE: f64 = 1e-9;
 ///
 /// The error names polygons from 1 like the scenario file: `sectors.polygon[2] overlaps
 /// sectors.polygon[5]`, `the sectors leave 120.5 of the table's area uncovered`.
-pub fn validate_layout(polys: &[Polygon], lo: Vec2, hi: Vec2) -> Result<(), String> {
+pub fn validate_layout(polys: &[Polygon], lo: Vec2, hi: Vec2) -> Result<(), LayoutError> {
     if !(lo.is_finite() && hi.is_finite() && lo.x < hi.x && lo.y < hi.y) {
-        return Err(format!(
-            "the table's box [{}, {}] .. [{}, {}] has no area",
-            lo.x, lo.y, hi.x, hi.y
-        ));
+        return Err(LayoutError::NoArea { lo, hi });
     }
     if polys.is_empty() {
-        return Err("there are no sectors: they leave all of the table's area uncovered".into());
+        return Err(LayoutError::NoSectors);
     }
     let size = (hi.x - lo.x).max(hi.y - lo.y);
     let tol = LAYOUT_TOLERANCE * size;
     for (i, poly) in polys.iter().enumerate() {
-        poly.check()
-            .map_err(|e| format!("sectors.polygon[{}] {e}", i + 1))?;
-        for p in &poly.points {
-            if p.x < lo.x - tol || p.x > hi.x + tol || p.y < lo.y - tol || p.y > hi.y + tol {
-                return Err(format!(
-                    "sectors.polygon[{}] reaches outside the table: point [{}, {}] is not in \
-                     [{}, {}] .. [{}, {}]",
-                    i + 1,
-                    p.x,
-                    p.y,
-                    lo.x,
-                    lo.y,
-                    hi.x,
-                    hi.y
-                ));
+        poly.check().map_err(|source| LayoutError::Polygon {
+            index: i + 1,
+            source,
+        })?;
+        for &point in &poly.points {
+            if point.x < lo.x - tol
+                || point.x > hi.x + tol
+                || point.y < lo.y - tol
+                || point.y > hi.y + tol
+            {
+                return Err(LayoutError::Outside {
+                    index: i + 1,
+                    point,
+                    lo,
+                    hi,
+                });
             }
         }
     }
@@ -358,11 +477,10 @@ pub fn validate_layout(polys: &[Polygon], lo: Vec2, hi: Vec2) -> Result<(), Stri
     for (i, j) in pairs {
         let (i, j) = (i as usize, j as usize);
         if interiors_overlap(&polys[i], ccw[i], &polys[j], ccw[j], tol) {
-            return Err(format!(
-                "sectors.polygon[{}] overlaps sectors.polygon[{}]",
-                i + 1,
-                j + 1
-            ));
+            return Err(LayoutError::Overlap {
+                first: i + 1,
+                second: j + 1,
+            });
         }
     }
     let table = (hi.x - lo.x) * (hi.y - lo.y);
@@ -374,17 +492,10 @@ pub fn validate_layout(polys: &[Polygon], lo: Vec2, hi: Vec2) -> Result<(), Stri
     let slack = LAYOUT_TOLERANCE * table + tol * perimeters;
     let missing = table - covered;
     if missing > slack {
-        return Err(format!(
-            "the sectors leave {} of the table's area uncovered",
-            short(missing)
-        ));
+        return Err(LayoutError::Uncovered { missing });
     }
     if missing < -slack {
-        return Err(format!(
-            "the sectors' areas add up to {}, more than the table's {}",
-            short(covered),
-            short(table)
-        ));
+        return Err(LayoutError::Overcovered { covered, table });
     }
     Ok(())
 }
@@ -939,23 +1050,34 @@ mod tests {
     fn new_rejects_bad_polygons() {
         assert!(Polygon::new(vec![v(0.0, 0.0), v(1.0, 0.0)])
             .unwrap_err()
+            .to_string()
             .contains("at least 3"));
         assert!(
             Polygon::new(vec![v(0.0, 0.0), v(1.0, 0.0), v(f64::NAN, 1.0)])
                 .unwrap_err()
+                .to_string()
                 .contains("point 3")
         );
         assert!(Polygon::new(vec![v(0.0, 0.0), v(1.0, 0.0), v(2.0, 0.0)])
             .unwrap_err()
+            .to_string()
             .contains("zero area"));
         assert!(
             Polygon::new(vec![v(0.0, 0.0), v(1.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)])
                 .unwrap_err()
+                .to_string()
                 .contains("same point")
         );
         // a bow tie
         let e = Polygon::new(vec![v(0.0, 0.0), v(1.0, 1.0), v(1.0, 0.0), v(0.0, 1.0)]).unwrap_err();
-        assert!(e.contains("edges 1 and 3 meet"), "{e}");
+        assert_eq!(
+            e,
+            PolygonError::EdgesMeet {
+                first: 1,
+                second: 3
+            }
+        );
+        assert!(e.to_string().contains("edges 1 and 3 meet"), "{e}");
         // a corner touching another edge
         let e = Polygon::new(vec![
             v(0.0, 0.0),
@@ -965,13 +1087,88 @@ mod tests {
             v(0.0, 4.0),
         ])
         .unwrap_err();
-        assert!(e.contains("meet"), "{e}");
+        assert!(e.to_string().contains("meet"), "{e}");
         // a spike folding back
         let e = Polygon::new(vec![v(0.0, 0.0), v(4.0, 0.0), v(2.0, 0.0), v(2.0, 3.0)]).unwrap_err();
-        assert!(e.contains("turns back"), "{e}");
+        assert!(e.to_string().contains("turns back"), "{e}");
         // the thesis' closed corner list is fine
         let p = Polygon::new(vec![v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.0, 0.0)]).unwrap();
         assert_eq!(p.points.len(), 3);
+    }
+
+    #[test]
+    fn error_messages() {
+        let bad = |pts: Vec<Vec2>| Polygon::new(pts).unwrap_err().to_string();
+        assert_eq!(
+            bad(vec![v(0.0, 0.0), v(1.0, 0.0)]),
+            "a polygon needs at least 3 distinct points, got 2"
+        );
+        assert_eq!(
+            bad(vec![v(0.0, 0.0), v(1.0, 0.0), v(f64::NAN, 1.5)]),
+            "point 3 must be two finite numbers, got [NaN, 1.5]"
+        );
+        assert_eq!(
+            bad(vec![v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.5), v(0.0, 1.5)]),
+            "points 3 and 4 are the same point [0, 1.5]"
+        );
+        assert_eq!(
+            bad(vec![v(0.0, 0.0), v(1.0, 0.0), v(2.0, 0.0)]),
+            "has zero area: all its points lie on one line"
+        );
+        assert_eq!(
+            bad(vec![v(0.0, 0.0), v(4.0, 0.0), v(2.0, 0.0), v(2.0, 3.0)]),
+            "turns back on itself at point 2 (the polygon must not intersect itself)"
+        );
+        assert_eq!(
+            bad(vec![v(0.0, 0.0), v(1.0, 1.0), v(1.0, 0.0), v(0.0, 1.0)]),
+            "edges 1 and 3 meet (the polygon must not intersect itself; edge k runs from point k \
+             to the next)"
+        );
+        assert_eq!(PolygonError::ZeroArea.to_string(), "has zero area");
+        let (lo, hi) = (v(0.0, 0.0), v(4.0, 2.0));
+        let rect = |x1: f64| Polygon {
+            points: vec![v(0.0, 0.0), v(x1, 0.0), v(x1, 2.0), v(0.0, 2.0)],
+        };
+        let layout = |polys: &[Polygon], hi: Vec2| validate_layout(polys, lo, hi).unwrap_err();
+        assert_eq!(
+            layout(&[rect(4.0)], v(0.0, 2.5)).to_string(),
+            "the table's box [0, 0] .. [0, 2.5] has no area"
+        );
+        assert_eq!(
+            layout(&[], hi).to_string(),
+            "there are no sectors: they leave all of the table's area uncovered"
+        );
+        let e = layout(
+            &[Polygon {
+                points: vec![v(0.0, 0.0), v(4.0, 0.0)],
+            }],
+            hi,
+        );
+        assert_eq!(
+            e.to_string(),
+            "sectors.polygon[1] a polygon needs at least 3 distinct points, got 2"
+        );
+        assert_eq!(e.polygon(), Some(1));
+        let e = layout(&[rect(3.0), rect(4.5)], hi);
+        assert_eq!(
+            e.to_string(),
+            "sectors.polygon[2] reaches outside the table: point [4.5, 0] is not in [0, 0] .. [4, 2]"
+        );
+        assert_eq!(e.polygon(), Some(2));
+        let e = layout(&[rect(2.0 / 3.0)], hi);
+        assert_eq!(
+            e.to_string(),
+            "the sectors leave 6.66667 of the table's area uncovered"
+        );
+        assert_eq!(e.polygon(), None);
+        let over = LayoutError::Overcovered {
+            covered: 8.5,
+            table: 8.0,
+        };
+        assert_eq!(
+            over.to_string(),
+            "the sectors' areas add up to 8.5, more than the table's 8"
+        );
     }
 
     #[test]
@@ -1099,13 +1296,22 @@ mod tests {
         let mut missing = g.clone();
         missing.remove(4);
         assert_eq!(
-            validate_layout(&missing, lo, hi).unwrap_err(),
+            validate_layout(&missing, lo, hi).unwrap_err().to_string(),
             "the sectors leave 30000 of the table's area uncovered"
         );
         let mut dup = g.clone();
         dup.push(g[1].clone());
+        let e = validate_layout(&dup, lo, hi).unwrap_err();
         assert_eq!(
-            validate_layout(&dup, lo, hi).unwrap_err(),
+            e,
+            LayoutError::Overlap {
+                first: 2,
+                second: 7
+            }
+        );
+        assert_eq!(e.polygon(), Some(2));
+        assert_eq!(
+            e.to_string(),
             "sectors.polygon[2] overlaps sectors.polygon[7]"
         );
         // the same square split along a diagonal, both triangles added to the grid
@@ -1121,11 +1327,12 @@ mod tests {
         validate_layout(&split, lo, hi).unwrap();
         split.push(Polygon::new(vec![a, b, d]).unwrap());
         let e = validate_layout(&split, lo, hi).unwrap_err();
-        assert!(e.contains("overlaps sectors.polygon[8]"), "{e}");
+        assert!(e.to_string().contains("overlaps sectors.polygon[8]"), "{e}");
         let mut out = g.clone();
         out[0].points[0] = v(-1.0, 0.0);
         assert!(validate_layout(&out, lo, hi)
             .unwrap_err()
+            .to_string()
             .starts_with("sectors.polygon[1] reaches outside"));
     }
 

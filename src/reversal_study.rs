@@ -4,7 +4,7 @@
 //! The setup is the thesis' (400 × 400 table, a 4 × 4 array of radius-30 balls, speeds uniform in
 //! [0, 100)); seed 3 gives over 100 collisions from −3 to 3, as the thesis reports.
 
-use crate::experiment::{register_font, write_png};
+use crate::experiment::{create_dir, draw_error, register_font, write, write_png, ExperimentError};
 use crate::model::pool::NvDelay;
 use crate::run::{reverse, EngineKind, FixedNews, ReversalReport, SectorChoice};
 use crate::scenario::builtin::{build, Params};
@@ -36,8 +36,8 @@ fn engines() -> [EngineKind; 3] {
 }
 
 /// Runs the sweep and writes `reversal.md`, `reversal.json`, `reversal_error.svg` and `.png`.
-pub fn run(dir: &Path, font: &Path, quick: bool) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+pub fn run(dir: &Path, font: &Path, quick: bool) -> Result<(), ExperimentError> {
+    create_dir(dir)?;
     let s = build(
         "reversal",
         &Params {
@@ -45,12 +45,12 @@ pub fn run(dir: &Path, font: &Path, quick: bool) -> Result<(), String> {
             ..Params::default()
         },
     )
-    .map_err(|e| format!("{}: {}", e.field, e.message))?;
+    .map_err(ExperimentError::Scenario)?;
     let qs: &[f64] = if quick { &QS_QUICK } else { &QS };
     let mut rows: Vec<ReversalReport> = Vec::new();
     for &q in qs {
         for engine in engines() {
-            rows.push(reverse(&s, engine, q, true).map_err(|e| e.to_string())?);
+            rows.push(reverse(&s, engine, q, true)?);
         }
     }
     let mut md = String::from(
@@ -82,7 +82,7 @@ pub fn run(dir: &Path, font: &Path, quick: bool) -> Result<(), String> {
          collisions) and saw the balls come back close to their starting positions (plates 5-6).\n",
     );
     write(&dir.join("reversal.md"), md.as_bytes())?;
-    let json = serde_json::to_string_pretty(&rows).map_err(|e| e.to_string())?;
+    let json = serde_json::to_string_pretty(&rows)?;
     write(&dir.join("reversal.json"), json.as_bytes())?;
     register_font(font)?;
     let points: Vec<(f64, f64)> = rows
@@ -107,9 +107,12 @@ pub fn run(dir: &Path, font: &Path, quick: bool) -> Result<(), String> {
 fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, plotters::coord::Shift>,
     points: &[(f64, f64)],
-) -> Result<(), String> {
-    let e = |err: DrawingAreaErrorKind<DB::ErrorType>| format!("drawing the reversal plot: {err}");
-    root.fill(&WHITE).map_err(e)?;
+) -> Result<(), ExperimentError>
+where
+    DB::ErrorType: 'static,
+{
+    let e = draw_error("the reversal plot");
+    root.fill(&WHITE).map_err(&e)?;
     let qmax = points.iter().map(|p| p.0).fold(1.0, f64::max) * 1.05;
     let emax = points.iter().map(|p| p.1).fold(1e-12, f64::max) * 10.0;
     let mut chart = ChartBuilder::on(root)
@@ -121,27 +124,23 @@ fn draw<DB: DrawingBackend>(
         .x_label_area_size(45)
         .y_label_area_size(80)
         .build_cartesian_2d(0.0..qmax, (1e-16..emax).log_scale())
-        .map_err(e)?;
+        .map_err(&e)?;
     chart
         .configure_mesh()
         .x_desc("Q (the run goes from -Q to Q)")
         .y_desc("largest position error")
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
-        .map_err(e)?;
+        .map_err(&e)?;
     chart
         .draw_series(LineSeries::new(
             points.iter().copied(),
             BLUE.stroke_width(2),
         ))
-        .map_err(e)?;
+        .map_err(&e)?;
     chart
         .draw_series(points.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
-        .map_err(e)?;
-    root.present().map_err(e)?;
+        .map_err(&e)?;
+    root.present().map_err(&e)?;
     Ok(())
-}
-
-fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }

@@ -16,7 +16,7 @@ pub use crate::model::sectored::FixedNews;
 use crate::model::sectored::Layout;
 use crate::output::digest;
 use crate::physics::kinetic_energy;
-use crate::polygon::Polygon;
+use crate::polygon::{LayoutError, Polygon, PolygonError};
 use crate::scenario::Scenario;
 use crate::scenario::SectorSpec;
 use crate::summary::{EventTotals, KineticEnergy, MessageCounts, RunSummary, TimeWarpSummary};
@@ -69,22 +69,44 @@ pub enum SectorChoice {
     Scenario,
 }
 
+/// Why a sector choice gives no layout on a scenario ([`sector_layout`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SectorLayoutError {
+    /// The scenario's own sectors were asked for, and it has none.
+    #[error("the scenario has no [sectors]")]
+    NoSectors,
+    /// One of the scenario's polygons is not a simple polygon.
+    #[error("sectors.polygon[{index}]: {source}")]
+    Polygon {
+        /// Which polygon, counted from 1.
+        index: usize,
+        /// What is wrong with it.
+        #[source]
+        source: PolygonError,
+    },
+    /// The scenario's polygons do not tile the table.
+    #[error(transparent)]
+    Layout(#[from] LayoutError),
+}
+
 /// The sector layout a choice gives on a scenario, or what is wrong with it.
-pub fn sector_layout(s: &Scenario, choice: SectorChoice) -> Result<Layout, String> {
+pub fn sector_layout(s: &Scenario, choice: SectorChoice) -> Result<Layout, SectorLayoutError> {
     let table = Table::new(s);
     Ok(match choice {
         SectorChoice::Auto => Layout::auto(&table, s.balls.len()),
         SectorChoice::Grid(nx, ny) => Layout::grid(&table, nx, ny),
         SectorChoice::Scenario => match &s.sectors {
-            None => return Err("the scenario has no [sectors]".into()),
+            None => return Err(SectorLayoutError::NoSectors),
             Some(SectorSpec::Grid { nx, ny }) => Layout::grid(&table, *nx, *ny),
             Some(SectorSpec::Polygons(polys)) => {
                 let mut out = Vec::new();
                 for (k, p) in polys.iter().enumerate() {
-                    out.push(
-                        Polygon::new(p.clone())
-                            .map_err(|e| format!("sectors.polygon[{}]: {e}", k + 1))?,
-                    );
+                    out.push(Polygon::new(p.clone()).map_err(|source| {
+                        SectorLayoutError::Polygon {
+                            index: k + 1,
+                            source,
+                        }
+                    })?);
                 }
                 Layout::new(out, &table)?
             }
@@ -238,7 +260,7 @@ pub fn build_objects(
                 "the sectored engine draws no frames itself (poolsim render does)".into(),
             ));
         }
-        let mut layout = sector_layout(scenario, sectors).map_err(RunError::Input)?;
+        let mut layout = sector_layout(scenario, sectors)?;
         layout.fixed_news = news;
         Ok(layout)
     };

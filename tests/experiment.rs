@@ -150,7 +150,7 @@ fn a_missing_font_is_a_clear_error_after_the_tables() {
         quick: true,
         font: Some(dir.path().join("no-such-font.ttf")),
     };
-    let err = run(&args, &mut |_| {}).unwrap_err();
+    let err = run(&args, &mut |_| {}).unwrap_err().to_string();
     assert!(
         err.contains("no-such-font.ttf") && err.contains("fonts-dejavu-core"),
         "{err}"
@@ -170,8 +170,14 @@ fn bad_arguments_name_the_option() {
         quick: true,
         font: None,
     };
-    assert!(run(&args, &mut |_| {}).unwrap_err().contains("--balls"));
+    assert!(run(&args, &mut |_| {})
+        .unwrap_err()
+        .to_string()
+        .contains("--balls"));
     args.balls = None;
     args.seeds = Some(0);
-    assert!(run(&args, &mut |_| {}).unwrap_err().contains("--seeds"));
+    assert!(run(&args, &mut |_| {})
+        .unwrap_err()
+        .to_string()
+        .contains("--seeds"));
 }

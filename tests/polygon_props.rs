@@ -519,14 +519,14 @@ proptest! {
         let k = pick % g.len();
         let mut missing = g.clone();
         missing.remove(k);
-        let e = validate_layout(&missing, lo, hi).unwrap_err();
+        let e = validate_layout(&missing, lo, hi).unwrap_err().to_string();
         prop_assert!(e.starts_with("the sectors leave ") && e.ends_with(" of the table's area uncovered"), "{e}");
         // shrink sector k from its top edge
         let (a, b) = g[k].bounds();
         let top = a.y + f * (b.y - a.y);
         let mut shrunk = g.clone();
         shrunk[k] = Polygon::new(vec![a, Vec2::new(b.x, a.y), Vec2::new(b.x, top), Vec2::new(a.x, top)]).unwrap();
-        let e = validate_layout(&shrunk, lo, hi).unwrap_err();
+        let e = validate_layout(&shrunk, lo, hi).unwrap_err().to_string();
         prop_assert!(e.contains("uncovered"), "{e}");
         // grow sector k into its right (or left) neighbour
         let col = k as u32 % nx;
@@ -542,7 +542,7 @@ proptest! {
             grown[k] = Polygon::new(vec![Vec2::new(x, a.y), Vec2::new(b.x, a.y), b, Vec2::new(x, b.y)]).unwrap();
             k - 1
         };
-        let e = validate_layout(&grown, lo, hi).unwrap_err();
+        let e = validate_layout(&grown, lo, hi).unwrap_err().to_string();
         prop_assert_eq!(
             e,
             format!("sectors.polygon[{}] overlaps sectors.polygon[{}]", k.min(other) + 1, k.max(other) + 1)
@@ -579,7 +579,7 @@ proptest! {
         let cell = &grid(lo, hi, nx, ny)[0];
         bad.push(Polygon::new(vec![cell.points[0], cell.points[1], cell.points[2]]).unwrap());
         bad.push(Polygon::new(vec![cell.points[1], cell.points[2], cell.points[3]]).unwrap());
-        let e = validate_layout(&bad, lo, hi).unwrap_err();
+        let e = validate_layout(&bad, lo, hi).unwrap_err().to_string();
         prop_assert!(e.contains("overlaps"), "{}", e);
     }
 }
@@ -683,7 +683,9 @@ fn non_grid_layouts() {
     ])
     .unwrap();
     assert_eq!(
-        validate_layout(&[l.clone(), big], lo, hi).unwrap_err(),
+        validate_layout(&[l.clone(), big], lo, hi)
+            .unwrap_err()
+            .to_string(),
         "sectors.polygon[1] overlaps sectors.polygon[2]"
     );
     // T-junctions: a left half against two right quarters
@@ -706,7 +708,7 @@ fn non_grid_layouts() {
     // a sector nested inside another
     let nested = [rect(0.0, 0.0, 4.0, 4.0), rect(1.0, 1.0, 2.0, 2.0)];
     assert_eq!(
-        validate_layout(&nested, lo, hi).unwrap_err(),
+        validate_layout(&nested, lo, hi).unwrap_err().to_string(),
         "sectors.polygon[1] overlaps sectors.polygon[2]"
     );
     // shared edges that differ by rounding are fine
@@ -717,7 +719,9 @@ fn non_grid_layouts() {
     ];
     validate_layout(&wobbly, lo, hi).unwrap();
     // a sector reaching off the table
-    let e = validate_layout(&[rect(0.0, 0.0, 4.0, 4.5)], lo, hi).unwrap_err();
+    let e = validate_layout(&[rect(0.0, 0.0, 4.0, 4.5)], lo, hi)
+        .unwrap_err()
+        .to_string();
     assert!(
         e.starts_with("sectors.polygon[1] reaches outside the table"),
         "{e}"

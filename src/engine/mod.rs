@@ -424,9 +424,12 @@ pub enum RunError {
     /// An observer's output failed (a trace file could not be written).
     #[error("output failed: {0}")]
     Output(String),
-    /// The run was asked for something the input does not allow (a bad sector layout).
+    /// The run was asked for something the input does not allow.
     #[error("{0}")]
     Input(String),
+    /// The sector layout asked for is unusable.
+    #[error(transparent)]
+    Layout(#[from] crate::run::SectorLayoutError),
     /// Time Warp failed: out of its memory budget, or a model bug committed.
     #[error("{0}")]
     TimeWarp(String),

@@ -1,7 +1,7 @@
 //! The runs: each gas once on the event-list engine (its physics) and once per setting on the
 //! objects engine (its messages), indexed by number of balls and setting.
 
-use super::{settings, Plan, Progress, Setting, RADIUS, SPEED_MAX};
+use super::{settings, ExperimentError, Plan, Progress, Setting, RADIUS, SPEED_MAX};
 use crate::engine::{Event, EventKind, Ignore, Observer, RunError, World};
 use crate::model::pool::NvDelay;
 use crate::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
@@ -123,7 +123,7 @@ impl Observer for FreePath {
 }
 
 /// The thesis gas of `n` balls with this seed.
-fn gas(n: usize, seed: u64) -> Result<Scenario, String> {
+fn gas(n: usize, seed: u64) -> Result<Scenario, ExperimentError> {
     builtin::build(
         "gas",
         &Params {
@@ -134,16 +134,20 @@ fn gas(n: usize, seed: u64) -> Result<Scenario, String> {
             ..Params::default()
         },
     )
-    .map_err(|e| {
-        format!(
-            "gas with {n} balls, seed {seed}: {}: {}",
-            e.field, e.message
-        )
+    .map_err(|invalid| ExperimentError::Gas {
+        balls: n,
+        seed,
+        invalid,
     })
 }
 
 /// Runs one gas with the event-list engine, measuring its physics.
-fn physics(s: &Scenario, n: usize, seed: u64, until: f64) -> Result<PhysicsRecord, String> {
+fn physics(
+    s: &Scenario,
+    n: usize,
+    seed: u64,
+    until: f64,
+) -> Result<PhysicsRecord, ExperimentError> {
     let mut fp = FreePath::new(s);
     let cfg = RunConfig {
         engine: EngineKind::EventList,
@@ -151,7 +155,11 @@ fn physics(s: &Scenario, n: usize, seed: u64, until: f64) -> Result<PhysicsRecor
         check: false,
         span: Default::default(),
     };
-    let report = execute(s, &cfg, &mut fp).map_err(|e| format!("{n} balls, seed {seed}: {e}"))?;
+    let report = execute(s, &cfg, &mut fp).map_err(|source| ExperimentError::Physics {
+        balls: n,
+        seed,
+        source,
+    })?;
     let (lo, hi) = s.bounds();
     Ok(PhysicsRecord {
         balls: n,
@@ -173,7 +181,7 @@ fn objects(
     setting: Setting,
     until: f64,
     repeats: u32,
-) -> Result<RunRecord, String> {
+) -> Result<RunRecord, ExperimentError> {
     let engine = match setting {
         Setting::NoSectors => EngineKind::Objects {
             delay: NvDelay::Exact,
@@ -190,16 +198,22 @@ fn objects(
         check: false,
         span: Default::default(),
     };
-    let fail = |e: RunError| format!("{n} balls, seed {seed}, sectors {}: {e}", setting.name());
+    let fail = |source: RunError| ExperimentError::Objects {
+        balls: n,
+        seed,
+        setting: setting.name(),
+        source,
+    };
     let report = execute(s, &cfg, &mut Ignore).map_err(fail)?;
     let mut walls = vec![report.wall_seconds];
     for _ in 1..repeats.max(1) {
         let again = execute(s, &cfg, &mut Ignore).map_err(fail)?;
         if again.summary.messages != report.summary.messages {
-            return Err(format!(
-                "{n} balls, seed {seed}, sectors {}: a repeated run sent different messages",
-                setting.name()
-            ));
+            return Err(ExperimentError::Unrepeatable {
+                balls: n,
+                seed,
+                setting: setting.name(),
+            });
         }
         walls.push(again.wall_seconds);
     }
@@ -342,7 +356,10 @@ impl Data {
 }
 
 /// Runs every cell of the plan, telling `progress` how far it has come.
-pub(super) fn measure(plan: &Plan, progress: &mut dyn FnMut(Progress)) -> Result<Data, String> {
+pub(super) fn measure(
+    plan: &Plan,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Data, ExperimentError> {
     let start = Instant::now();
     let total: u64 = plan
         .balls

@@ -2,7 +2,7 @@
 //! measured parameters against our message counts (right), as SVG and PNG.
 
 use super::data::Data;
-use super::{settings, write, Setting};
+use super::{settings, write, ExperimentError, Setting};
 use crate::analytic::{self, ModelParams};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -17,17 +17,14 @@ static FONTS: Mutex<Vec<(PathBuf, &'static [u8])>> = Mutex::new(Vec::new());
 /// Reads the font at `path` and registers it as plotters' `sans-serif` (the family every text
 /// of the figures uses). A missing or unreadable font is an error naming the file and the
 /// Debian package, never a panic.
-pub(crate) fn register_font(path: &Path) -> Result<(), String> {
+pub(crate) fn register_font(path: &Path) -> Result<(), ExperimentError> {
     let mut fonts = FONTS.lock().unwrap_or_else(|e| e.into_inner());
     let bytes = match fonts.iter().find(|f| f.0 == path) {
         Some(f) => f.1,
         None => {
-            let bytes = std::fs::read(path).map_err(|e| {
-                format!(
-                    "cannot read the font {} for the figures: {e} (install Debian's \
-                     fonts-dejavu-core, or pass --font FILE with a TrueType font)",
-                    path.display()
-                )
+            let bytes = std::fs::read(path).map_err(|source| ExperimentError::ReadFont {
+                path: path.to_path_buf(),
+                source,
             })?;
             let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
             fonts.push((path.to_path_buf(), bytes));
@@ -35,12 +32,8 @@ pub(crate) fn register_font(path: &Path) -> Result<(), String> {
         }
     };
     for family in ["sans-serif", "serif", "monospace"] {
-        plotters::style::register_font(family, FontStyle::Normal, bytes).map_err(|_| {
-            format!(
-                "the font {} is not a TrueType or OpenType font",
-                path.display()
-            )
-        })?;
+        plotters::style::register_font(family, FontStyle::Normal, bytes)
+            .map_err(|_| ExperimentError::NotAFont(path.to_path_buf()))?;
     }
     Ok(())
 }
@@ -107,8 +100,14 @@ const H: u32 = 600;
 const THESIS_N: [f64; 4] = [8.0, 16.0, 32.0, 64.0];
 
 /// An error mapper naming what was being drawn.
-fn err<E: std::fmt::Display>(what: &str) -> impl Fn(E) -> String + '_ {
-    move |e| format!("drawing {what}: {e}")
+pub(crate) fn draw_error<E>(what: &str) -> impl Fn(E) -> ExperimentError + '_
+where
+    E: std::error::Error + Send + Sync + 'static,
+{
+    move |e| ExperimentError::Draw {
+        what: what.to_string(),
+        source: Box::new(e),
+    }
 }
 
 /// Draws figure 17 (`eq == 1`) or 18 (`eq == 2`) on any plotters backend.
@@ -117,11 +116,11 @@ fn draw_figure<DB: DrawingBackend>(
     eq: u32,
     ms: &[Measured],
     name: &str,
-) -> Result<(), String>
+) -> Result<(), ExperimentError>
 where
     DB::ErrorType: 'static,
 {
-    let e = err(name);
+    let e = draw_error(name);
     root.fill(&WHITE).map_err(&e)?;
     let title = if eq == 1 {
         "Figure 17. Messages as a function of sector size: no collisions (eq. 1)"
@@ -196,11 +195,11 @@ fn draw_thesis_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     eq: u32,
     name: &str,
-) -> Result<(), String>
+) -> Result<(), ExperimentError>
 where
     DB::ErrorType: 'static,
 {
-    let e = err(name);
+    let e = draw_error(name);
     let curves = thesis_curves(eq);
     let y_max = curves
         .iter()
@@ -238,11 +237,11 @@ fn draw_thesis_curves<DB: DrawingBackend>(
     eq: u32,
     curves: &[(f64, Vec<(f64, f64)>)],
     name: &str,
-) -> Result<(), String>
+) -> Result<(), ExperimentError>
 where
     DB::ErrorType: 'static,
 {
-    let e = err(name);
+    let e = draw_error(name);
     for (n, pts) in curves {
         let c = color_of(*n as usize);
         chart
@@ -291,7 +290,7 @@ where
 fn draw_legend<'a, 'b, DB: DrawingBackend + 'a + 'b, CT: CoordTranslate>(
     chart: &'b mut ChartContext<'a, DB, CT>,
     name: &str,
-) -> Result<(), String>
+) -> Result<(), ExperimentError>
 where
     DB::ErrorType: 'static,
 {
@@ -302,7 +301,7 @@ where
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()
-        .map_err(err(name))
+        .map_err(draw_error(name))
 }
 
 /// The model's parameters at what we measured for `m.n` balls, for eq. 1 or eq. 2.
@@ -375,11 +374,11 @@ fn draw_measured_panel<DB: DrawingBackend>(
     eq: u32,
     ms: &[Measured],
     name: &str,
-) -> Result<(), String>
+) -> Result<(), ExperimentError>
 where
     DB::ErrorType: 'static,
 {
-    let e = err(name);
+    let e = draw_error(name);
     let s_min = ms
         .iter()
         .flat_map(|m| m.points.iter().map(|p| p.0))
@@ -433,13 +432,13 @@ fn draw_measured<DB: DrawingBackend, X, Y>(
     curve: Option<&[(f64, f64)]>,
     s_min: f64,
     name: &str,
-) -> Result<(), String>
+) -> Result<(), ExperimentError>
 where
     DB::ErrorType: 'static,
     X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
-    let e = err(name);
+    let e = draw_error(name);
     let c = color_of(m.n);
     if let Some(pts) = curve {
         chart
@@ -482,7 +481,7 @@ where
 }
 
 /// Writes `figNN.svg` and `figNN.png` for equation `eq`.
-pub(super) fn write_figure(dir: &Path, eq: u32, ms: &[Measured]) -> Result<(), String> {
+pub(super) fn write_figure(dir: &Path, eq: u32, ms: &[Measured]) -> Result<(), ExperimentError> {
     let stem = if eq == 1 { "fig17" } else { "fig18" };
     let mut svg = String::new();
     {
@@ -499,7 +498,7 @@ pub(super) fn write_figure(dir: &Path, eq: u32, ms: &[Measured]) -> Result<(), S
 }
 
 /// Encodes an RGB buffer of `w` × `h` pixels as a PNG file.
-pub(crate) fn write_png(path: &Path, buf: &[u8], w: u32, h: u32) -> Result<(), String> {
+pub(crate) fn write_png(path: &Path, buf: &[u8], w: u32, h: u32) -> Result<(), ExperimentError> {
     let mut png_bytes = Vec::new();
     {
         let mut enc = png::Encoder::new(&mut png_bytes, w, h);
@@ -507,11 +506,12 @@ pub(crate) fn write_png(path: &Path, buf: &[u8], w: u32, h: u32) -> Result<(), S
         enc.set_depth(png::BitDepth::Eight);
         enc.set_compression(png::Compression::Best);
         enc.set_adaptive_filter(png::AdaptiveFilterType::Adaptive);
-        let mut w = enc
-            .write_header()
-            .map_err(|e| format!("encoding {}: {e}", path.display()))?;
-        w.write_image_data(buf)
-            .map_err(|e| format!("encoding {}: {e}", path.display()))?;
+        let encode = |source| ExperimentError::Encode {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut w = enc.write_header().map_err(encode)?;
+        w.write_image_data(buf).map_err(encode)?;
     }
     write(path, &png_bytes)
 }

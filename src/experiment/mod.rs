@@ -26,6 +26,7 @@
 // and `results` gathers `results.json`.
 
 mod data;
+mod error;
 mod figures;
 mod findings;
 mod report;
@@ -34,7 +35,8 @@ mod tables;
 mod thesis;
 
 pub use data::{PhysicsRecord, RunRecord, Stat};
-pub(crate) use figures::{register_font, write_png};
+pub use error::ExperimentError;
+pub(crate) use figures::{draw_error, register_font, write_png};
 
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -117,10 +119,10 @@ pub struct Plan {
 impl Plan {
     /// The plan the arguments ask for: `--quick` changes the defaults, explicit `--seeds` and
     /// `--balls` win over them. Errors name the option.
-    pub fn from_options(a: &ExperimentOptions) -> Result<Plan, String> {
+    pub fn from_options(a: &ExperimentOptions) -> Result<Plan, ExperimentError> {
         let seeds = a.seeds.unwrap_or(if a.quick { 2 } else { 6 });
         if seeds == 0 || seeds > 1000 {
-            return Err(format!("--seeds must be from 1 to 1000, got {seeds}"));
+            return Err(ExperimentError::Seeds(seeds));
         }
         let mut balls = a.balls.clone().unwrap_or_else(|| {
             if a.quick {
@@ -130,13 +132,11 @@ impl Plan {
             }
         });
         if balls.is_empty() {
-            return Err("--balls needs at least one number of balls".into());
+            return Err(ExperimentError::NoBalls);
         }
         for &n in &balls {
             if !(1..=4096).contains(&n) || isqrt(n).is_none() {
-                return Err(format!(
-                    "--balls: {n} is not a square number from 1 to 4096 (the gas is k x k balls)"
-                ));
+                return Err(ExperimentError::NotSquare(n));
             }
         }
         balls.sort_unstable();
@@ -230,14 +230,28 @@ pub fn settings(n: usize) -> Vec<Setting> {
 }
 
 /// Writes `bytes` to `path`, with an error naming the file.
-fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
+pub(crate) fn write(path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
+    std::fs::write(path, bytes).map_err(|source| ExperimentError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Creates the directory `dir` and its parents, with an error naming it.
+pub(crate) fn create_dir(dir: &Path) -> Result<(), ExperimentError> {
+    std::fs::create_dir_all(dir).map_err(|source| ExperimentError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })
 }
 
 /// Runs `poolsim experiment`: every run of the plan, then the tables, `results.json` and the
 /// report, then the figures. Errors are one line for the user (bad arguments, a failed run, an
 /// unwritable directory, a missing font); files written before an error stay.
-pub fn run(args: &ExperimentOptions, progress: &mut dyn FnMut(Progress)) -> Result<(), String> {
+pub fn run(
+    args: &ExperimentOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(), ExperimentError> {
     if args.which == Which::Reversal {
         if let Some(flag) = [
             ("--seeds", args.seeds.is_some()),
@@ -246,10 +260,7 @@ pub fn run(args: &ExperimentOptions, progress: &mut dyn FnMut(Progress)) -> Resu
         .iter()
         .find_map(|&(flag, given)| given.then_some(flag))
         {
-            return Err(format!(
-                "{flag}: only the thesis experiment takes it (the reversal study has its own \
-                 scenarios and quitting times)"
-            ));
+            return Err(ExperimentError::ThesisOnly { flag });
         }
         let font = args
             .font
@@ -259,7 +270,7 @@ pub fn run(args: &ExperimentOptions, progress: &mut dyn FnMut(Progress)) -> Resu
     }
     let plan = Plan::from_options(args)?;
     let dir = &args.out;
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    create_dir(dir)?;
     let data = data::measure(&plan, progress)?;
     let tables = vec![
         ("table5", tables::table5(&data)),
@@ -274,7 +285,7 @@ pub fn run(args: &ExperimentOptions, progress: &mut dyn FnMut(Progress)) -> Resu
     }
     let fs = findings::findings(&data);
     let results = serde_json::to_string_pretty(&results::results_json(&data, &fs))
-        .map_err(|e| format!("results.json: {e}"))?;
+        .map_err(ExperimentError::Results)?;
     write(&dir.join("results.json"), results.as_bytes())?;
     let font = args
         .font
@@ -289,11 +300,10 @@ pub fn run(args: &ExperimentOptions, progress: &mut dyn FnMut(Progress)) -> Resu
     write(&dir.join("report.md"), report.as_bytes())?;
     figures?;
     if !data.mismatches.is_empty() {
-        return Err(format!(
-            "{} runs did not end in the event-list engine's final state; first: {}",
-            data.mismatches.len(),
-            data.mismatches[0]
-        ));
+        return Err(ExperimentError::Mismatch {
+            count: data.mismatches.len(),
+            first: data.mismatches[0].clone(),
+        });
     }
     Ok(())
 }
@@ -353,9 +363,15 @@ mod tests {
         let p = Plan::from_options(&a).unwrap();
         assert_eq!((p.balls, p.seeds, p.until), (vec![4, 16], 2, 4.0));
         a.balls = Some(vec![10]);
-        assert!(Plan::from_options(&a).unwrap_err().contains("--balls"));
+        assert_eq!(
+            Plan::from_options(&a).unwrap_err().to_string(),
+            "--balls: 10 is not a square number from 1 to 4096 (the gas is k x k balls)"
+        );
         a.balls = None;
         a.seeds = Some(0);
-        assert!(Plan::from_options(&a).unwrap_err().contains("--seeds"));
+        assert_eq!(
+            Plan::from_options(&a).unwrap_err().to_string(),
+            "--seeds must be from 1 to 1000, got 0"
+        );
     }
 }

@@ -6,7 +6,7 @@ use super::data::Data;
 use super::findings::{bps_of, bps_text, monotone, opt_label, Finding, Paired};
 use super::tables::{setting_at, spreadsheet, thesis9_column, Sheet};
 use super::thesis;
-use super::{settings, Setting, RADIUS, SPEED_MAX};
+use super::{settings, ExperimentError, Setting, RADIUS, SPEED_MAX};
 use minijinja::{AutoEscape, Environment, UndefinedBehavior};
 use serde::Serialize;
 
@@ -20,7 +20,7 @@ pub(super) fn report(
     tables: &[(&str, String)],
     fs: &[Finding],
     figures: bool,
-) -> Result<String, String> {
+) -> Result<String, ExperimentError> {
     let p = &data.plan;
     let ctx = Context {
         quick: p.quick,
@@ -66,7 +66,7 @@ pub(super) fn report(
 }
 
 /// Fills the template in.
-fn render(ctx: &Context) -> Result<String, String> {
+fn render(ctx: &Context) -> Result<String, ExperimentError> {
     let mut env = Environment::new();
     env.set_trim_blocks(true);
     env.set_lstrip_blocks(true);
@@ -75,7 +75,7 @@ fn render(ctx: &Context) -> Result<String, String> {
     env.set_auto_escape_callback(|_| AutoEscape::None);
     env.add_template("report.md", TEMPLATE)
         .and_then(|()| env.get_template("report.md")?.render(ctx))
-        .map_err(|e| format!("report.md: {e:#}"))
+        .map_err(ExperimentError::Report)
 }
 
 /// The title of a table's Markdown: its first line without `# `.

@@ -3,7 +3,7 @@
 
 use crate::engine::{Fixed, Table};
 use crate::geometry::Vec2;
-use crate::polygon::{self, Polygon};
+use crate::polygon::{self, LayoutError, Polygon};
 
 /// The sectors of a table: their polygons, which touch which, and a bucket index of their boxes
 /// so that finding the sectors a disk touches costs O(1), not O(sectors).
@@ -109,7 +109,7 @@ impl BoxIndex {
 
 impl Layout {
     /// A layout of the given polygons, which must cover the table's box without overlapping.
-    pub fn new(polys: Vec<Polygon>, table: &Table) -> Result<Layout, String> {
+    pub fn new(polys: Vec<Polygon>, table: &Table) -> Result<Layout, LayoutError> {
         polygon::validate_layout(&polys, table.lo, table.hi)?;
         Ok(Layout::covering(polys, table))
     }

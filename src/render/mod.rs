@@ -359,7 +359,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
     let drawn = match (cfg.sectors, cfg.engine) {
         (None, _) => None,
         (Some(_), EngineKind::Sectored { sectors, .. }) | (Some(sectors), _) => {
-            Some(sector_layout(scenario, sectors).map_err(RunError::Input)?)
+            Some(sector_layout(scenario, sectors)?)
         }
     };
     let sectored = matches!(cfg.engine, EngineKind::Sectored { .. });
@@ -429,7 +429,7 @@ pub enum Output {
 impl Output {
     /// The output a path names, by its extension; a single picture file (`.png`, `.svg`, …) is
     /// refused, since a run has many frames.
-    pub fn from_path(path: &Path) -> Result<Output, String> {
+    pub fn from_path(path: &Path) -> Result<Output, OutputError> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
@@ -438,18 +438,13 @@ impl Output {
             Some("html" | "htm") => Output::Html(path.to_path_buf()),
             Some("gif") => Output::Gif(path.to_path_buf()),
             Some(ext @ ("png" | "svg" | "jpg" | "jpeg" | "webp")) => {
-                return Err(format!(
-                    "--out: {}: a run has many frames, so not one .{ext} file; give a folder \
-                     (frame-0000.svg and .png, ...), FILE.html or FILE.gif",
-                    path.display()
-                ))
+                return Err(OutputError::Picture {
+                    path: path.to_path_buf(),
+                    ext: ext.to_string(),
+                })
             }
             _ if path.exists() && !path.is_dir() => {
-                return Err(format!(
-                    "--out: {} is a file, not a folder for the frames; name a folder, FILE.html \
-                     or FILE.gif",
-                    path.display()
-                ))
+                return Err(OutputError::File(path.to_path_buf()))
             }
             _ => Output::Folder(path.to_path_buf()),
         })
@@ -459,6 +454,29 @@ impl Output {
     pub fn needs_font(&self) -> bool {
         !matches!(self, Output::Html(_))
     }
+}
+
+/// Why a path names no [`Output`] ([`Output::from_path`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum OutputError {
+    /// A single picture file, where a run makes many frames.
+    #[error(
+        "--out: {}: a run has many frames, so not one .{ext} file; give a folder \
+         (frame-0000.svg and .png, ...), FILE.html or FILE.gif",
+        .path.display()
+    )]
+    Picture {
+        /// The path.
+        path: PathBuf,
+        /// Its extension, in lower case.
+        ext: String,
+    },
+    /// An existing file that is not a folder.
+    #[error(
+        "--out: {} is a file, not a folder for the frames; name a folder, FILE.html or FILE.gif",
+        .0.display()
+    )]
+    File(PathBuf),
 }
 
 /// Why a picture could not be made.

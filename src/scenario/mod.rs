@@ -462,17 +462,17 @@ impl Scenario {
                 for (i, poly) in polys.iter().enumerate() {
                     let f = format!("sectors.polygon[{}].points", i + 1);
                     shapes.push(
-                        crate::polygon::Polygon::new(poly.clone()).map_err(|e| invalid(f, e))?,
+                        crate::polygon::Polygon::new(poly.clone())
+                            .map_err(|e| invalid(f, e.to_string()))?,
                     );
                 }
                 let (lo, hi) = self.bounds();
                 crate::polygon::validate_layout(&shapes, lo, hi).map_err(|e| {
                     // blame the first polygon the message names, for its line in the file
                     let field = e
-                        .find("sectors.polygon[")
-                        .and_then(|at| e[at..].find(']').map(|end| e[at..=at + end].to_string()))
-                        .unwrap_or_else(|| "sectors".into());
-                    invalid(field, e)
+                        .polygon()
+                        .map_or_else(|| "sectors".into(), |k| format!("sectors.polygon[{k}]"));
+                    invalid(field, e.to_string())
                 })
             }
         }

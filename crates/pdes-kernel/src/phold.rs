@@ -188,10 +188,18 @@ pub struct PholdReport {
     pub time_warp: Option<TwStats>,
 }
 
+/// Why a PHOLD run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PholdError {
+    /// The executor failed (Time Warp out of its memory budget).
+    #[error(transparent)]
+    Exec(#[from] ExecError<Infallible>),
+}
+
 /// Runs PHOLD up to time `end`, sequentially or (with `tw`) under Time Warp, one partition per
 /// worker when the partitions match the workers. Fails only when Time Warp does (its memory
 /// budget).
-pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdReport, String> {
+pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdReport, PholdError> {
     let start = std::time::Instant::now();
     let (objects, events_per_object, remote, partitions) = (
         cfg.objects,
@@ -212,9 +220,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
             Box::new(TimeWarp::new(model, states, t0, &worker_of, c))
         }
     };
-    if let Err(ExecError::Failed(m)) = ex.run(end, &mut { never }) {
-        return Err(m);
-    }
+    ex.run(end, &mut { never })?;
     let (stats, finals, time_warp) = (ex.stats().clone(), ex.states().to_vec(), ex.tw_stats());
     ex.free();
     let wall = start.elapsed().as_secs_f64();

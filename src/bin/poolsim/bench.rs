@@ -100,7 +100,7 @@ pub fn bench(a: &BenchArgs) -> Result<(), Failure> {
             table.print(m);
         }
     })
-    .map_err(usage)?;
+    .map_err(|e| usage(e.to_string()))?;
     if a.json {
         println!("{}", serde_json::to_string(&report).expect("plain data"));
     }

@@ -115,6 +115,7 @@ pub fn load(spec: &str, gen: &GenArgs) -> Result<Scenario, Failure> {
 pub fn run_failure(e: RunError) -> Failure {
     match e {
         RunError::Input(m) => usage(m),
+        e @ RunError::Layout(_) => usage(e.to_string()),
         e => internal(e.to_string()),
     }
 }

@@ -76,5 +76,5 @@ pub fn experiment(a: &ExperimentArgs) -> Result<(), Failure> {
         Progress::RunDone => bar.inc(1),
         Progress::Finished => bar.finish_and_clear(),
     };
-    experiment::run(&a.options(), &mut progress).map_err(usage)
+    experiment::run(&a.options(), &mut progress).map_err(|e| usage(e.to_string()))
 }

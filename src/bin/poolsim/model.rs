@@ -30,7 +30,7 @@ pub fn model(a: &ModelArgs) -> Result<(), Failure> {
         time: a.time,
         changes: a.changes,
     };
-    p.validate().map_err(usage)?;
+    p.validate().map_err(|e| usage(e.to_string()))?;
     if a.json {
         println!("{}", report_json(&p));
     } else {

@@ -127,7 +127,7 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
         a.end,
         tw,
     )
-    .map_err(internal)?;
+    .map_err(|e| internal(e.to_string()))?;
     if pdes_kernel::time_warp::threads::place().0 != 0 {
         return Ok(());
     }

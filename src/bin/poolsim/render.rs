@@ -45,7 +45,7 @@ pub fn render_to(
     out: &std::path::Path,
 ) -> Result<(poolsim::render::Recording, String), Failure> {
     use poolsim::render::{raster::Rasterizer, record, write, Output, RenderError};
-    let out = Output::from_path(out).map_err(usage)?;
+    let out = Output::from_path(out).map_err(|e| usage(e.to_string()))?;
     let rasterizer = if out.needs_font() {
         Some(Rasterizer::new().map_err(|e| internal(e.to_string()))?)
     } else {
