@@ -218,7 +218,6 @@ struct Did<'a, M: Model> {
 
 /// A batch taken off a worker's queue: every live message for one object at one time.
 struct Taken<M: Model> {
-    time: VTime<M::Time>,
     /// The object, and its index on this worker.
     to: u32,
     li: usize,
@@ -742,8 +741,8 @@ impl<M: Model> Worker<M> {
         if final_only && !self.head_may_run_final(fabric) {
             return false;
         }
-        let mut taken = self.take_batch();
-        let run_final = self.settle_final(model, fabric, &mut taken);
+        let (time, mut taken) = self.take_batch();
+        let run_final = self.settle_final(model, fabric, &time, &mut taken);
         // the next batch's object, most likely (a local one: its message is here): where it
         // lives now, and its record once the handler has run (not at once: the record's place
         // is itself a load, and the step would wait for it)
@@ -754,12 +753,11 @@ impl<M: Model> Worker<M> {
         if !run_final {
             taken.saved = Some(self.save_state(model, taken.to, taken.li));
         }
-        self.check_depth(&taken.time, taken.to, run_final);
+        self.check_depth(&time, taken.to, run_final);
         let (to, li, next) = (taken.to, taken.li, taken.next);
         let lp = &mut self.lps[li];
         let (pre_seq, first) = (lp.seq, lp.uids);
-        let mut ctx =
-            Ctx::speculative(model, taken.time.clone(), to, &mut lp.seq).named(&mut lp.uids);
+        let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq).named(&mut lp.uids);
         ctx.sent = std::mem::take(&mut self.spare.pending);
         model.handle(&mut ctx, to, &mut lp.state, &taken.batch);
         let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
@@ -767,7 +765,7 @@ impl<M: Model> Worker<M> {
         self.stats.processed += 1;
         let mut ops = std::mem::take(&mut self.spare.ops);
         let did = Did {
-            time: taken.time.clone(),
+            time,
             uids: first,
             pre_seq,
             delivered: taken.batch.len(),
@@ -803,10 +801,10 @@ impl<M: Model> Worker<M> {
         Floor::of(&time, to) <= self.gvt || self.may_run_final(fabric, &time, to, true).is_some()
     }
 
-    /// Takes the next batch off the queue: every live message for the head's object at the
-    /// head's time (messages marked as cancelled or retracted are set aside).
-    #[inline]
-    fn take_batch(&mut self) -> Taken<M> {
+    /// Takes the next batch off the queue, with its time: every live message for the head's
+    /// object at the head's time (messages marked as cancelled or retracted are set aside).
+    #[inline(always)]
+    fn take_batch(&mut self) -> (VTime<M::Time>, Taken<M>) {
         let head = self.heap.pop().expect("a valid top");
         let (time, to) = (head.p.time.clone(), head.p.to);
         if self.current != time.key {
@@ -841,8 +839,7 @@ impl<M: Model> Worker<M> {
                 mark => self.marks.set_aside(it.uid, it.p, mark, self.gvt.t),
             }
         }
-        Taken {
-            time,
+        let taken = Taken {
             to,
             li,
             inputs,
@@ -850,16 +847,23 @@ impl<M: Model> Worker<M> {
             cancellable,
             next,
             saved: None,
-        }
+        };
+        (time, taken)
     }
 
     /// Whether the batch runs as final. A batch before everything still to come is final, and
     /// so are the object's earlier ones: this commits those, and the batch then runs without
     /// saving the state (unless a key deeper than a floor keeps left batches of the instant
     /// uncommitted).
-    #[inline]
-    fn settle_final<F: Fabric<M>>(&mut self, model: &M, fabric: &F, taken: &mut Taken<M>) -> bool {
-        let (time, to, li) = (&taken.time, taken.to, taken.li);
+    #[inline(always)]
+    fn settle_final<F: Fabric<M>>(
+        &mut self,
+        model: &M,
+        fabric: &F,
+        time: &VTime<M::Time>,
+        taken: &mut Taken<M>,
+    ) -> bool {
+        let (to, li) = (taken.to, taken.li);
         let by = if self.final_ok {
             self.may_run_final(fabric, time, to, taken.cancellable)
         } else {
@@ -888,7 +892,7 @@ impl<M: Model> Worker<M> {
     /// than GVT can pass (it would pile up batches until memory ran out). A cascade run on a
     /// state still to be rolled back may be wrong, and is stopped by the bound on uncommitted
     /// batches instead, until GVT reaches it.
-    #[inline]
+    #[inline(always)]
     fn check_depth(&mut self, time: &VTime<M::Time>, to: u32, run_final: bool) {
         if time.key.depth() > MAX_CASCADE_DEPTH && (run_final || Floor::of(time, to) <= self.gvt) {
             self.fault.get_or_insert(format!(
@@ -901,7 +905,7 @@ impl<M: Model> Worker<M> {
 
     /// Files a batch run speculatively in its object's history, with its saved state, what it
     /// sent and what it cancelled (to be undone by a rollback), and sends its messages.
-    #[inline]
+    #[inline(always)]
     fn log_batch(
         &mut self,
         model: &M,
@@ -910,7 +914,7 @@ impl<M: Model> Worker<M> {
         sent: &mut Vec<Pending<M::Time, M::Msg>>,
         ops: &mut Vec<Op<M::Time, M::Msg>>,
     ) {
-        let (to, li, time) = (taken.to, taken.li, taken.time);
+        let (to, li, time) = (taken.to, taken.li, did.time);
         let mut sent_recs = take(&mut self.spare.sent);
         for (n, p) in (did.uids + 1..).zip(sent.iter()) {
             let s = Sent {
@@ -966,6 +970,7 @@ impl<M: Model> Worker<M> {
 
     /// Commits a batch that ran as final at once, keeping no record of it: counts it, sends
     /// its messages, and turns its cancellations into retractions, pushed to `ops`.
+    #[inline(always)]
     fn commit_final(
         &mut self,
         model: &M,
@@ -1204,6 +1209,7 @@ impl<M: Model> Worker<M> {
 
     /// Counts a committed batch that handled `delivered` messages and made `cancels`
     /// cancellations; a send into the past it tried is now a model bug.
+    #[inline(always)]
     fn count_committed(&mut self, into_past: Option<String>, delivered: usize, cancels: usize) {
         if let Some(what) = into_past {
             self.fault
@@ -1236,6 +1242,7 @@ impl<M: Model> Worker<M> {
     }
 
     /// Commits the batches of local object `li` that `floor` passed, oldest first.
+    #[inline(always)]
     fn commit_front(&mut self, model: &M, li: usize, floor: &Floor) {
         // most objects have nothing uncommitted when they run a final batch
         if self.lps[li].history.is_empty() {
