@@ -18,7 +18,7 @@ use std::time::Instant;
 /// What `poolsim bench` measures.
 #[derive(Clone, Debug)]
 pub struct BenchOptions {
-    /// Ball counts of the event-list rows (each rounded to a square number).
+    /// Ball counts of the event-list rows.
     pub balls: Vec<usize>,
     /// Area fractions of the event-list rows.
     pub area_fractions: Vec<f64>,
@@ -314,21 +314,20 @@ fn proc_status_mib(field: &str) -> f64 {
         .map_or(0.0, |kb| kb / 1024.0)
 }
 
-/// The thesis gas (seed 1) with `balls` rounded to a square number, at `area_fraction` where
-/// given; returns the ball count with it.
+/// The thesis gas (seed 1) of `balls` balls, at `area_fraction` where given; returns the ball
+/// count with it.
 fn thesis_gas(
     balls: usize,
     area_fraction: Option<f64>,
 ) -> Result<(usize, crate::scenario::Scenario), BenchError> {
-    let k = ((balls as f64).sqrt().round() as usize).max(1);
     let params = Params {
-        balls: Some(k * k),
+        balls: Some(balls),
         seed: Some(1),
         area_fraction,
         ..Params::default()
     };
     let scenario = builtin::build("gas", &params).map_err(BenchError::Scenario)?;
-    Ok((k * k, scenario))
+    Ok((balls, scenario))
 }
 
 /// Measures one configuration.

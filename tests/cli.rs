@@ -507,8 +507,8 @@ fn missing_file_is_named() {
 fn bad_options_name_the_flag() {
     let cases: [(&[&str], &[&str]); 7] = [
         (
-            &["run", "gas", "--balls", "10"],
-            &["--balls", "square", "10"],
+            &["run", "gas", "--balls", "0"],
+            &["--balls", "whole number", "got 0"],
         ),
         (&["run", "gas", "--until", "-1"], &["--until", "-1"]),
         (

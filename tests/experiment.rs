@@ -166,7 +166,7 @@ fn bad_arguments_name_the_option() {
         which: Which::Thesis,
         out: dir.path().to_path_buf(),
         seeds: None,
-        balls: Some(vec![5]),
+        balls: Some(vec![5000]),
         quick: true,
         font: None,
     };

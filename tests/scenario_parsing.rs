@@ -280,3 +280,72 @@ fn overlapping_sector_polygons_are_rejected_at_load() {
     assert_eq!(e.field, "sectors.polygon[1]");
     assert!(e.line.is_some(), "{e}");
 }
+
+/// One cushion or pocket wound the wrong way on a closed table is named; an open table (a
+/// single wall, walls with a gap) keeps working.
+#[test]
+fn one_cushion_wound_the_wrong_way_is_named() {
+    let ball = ball_at(100.0, 100.0);
+    for k in 1..=4 {
+        // swap from and to of the k-th cushion only
+        let mut parts: Vec<String> = SQUARE.split("[[cushion]]\n").map(String::from).collect();
+        parts[k] = parts[k]
+            .replace("from", "FROM")
+            .replace("to =", "from =")
+            .replace("FROM", "to");
+        let table = parts.join("[[cushion]]\n");
+        let e = parse(&(ball.clone() + &table), SOURCE).unwrap_err();
+        assert_eq!(e.field, format!("cushion[{k}]"), "{e}");
+        assert!(e.message.contains("runs the wrong way"), "{e}");
+        assert!(e.line.is_some(), "{e}");
+    }
+    let pocketed = SQUARE.replace(
+        "[[cushion]]\nfrom = [400.0, 0.0]\nto = [0.0, 0.0]\n",
+        "[[cushion]]\nfrom = [400.0, 0.0]\nto = [60.0, 0.0]\n[[pocket]]\nfrom = [0.0, 0.0]\nto = [60.0, 0.0]\n",
+    );
+    let e = parse(&(ball.clone() + &pocketed), SOURCE).unwrap_err();
+    assert_eq!(e.field, "pocket[1]", "{e}");
+    let open = "[[cushion]]\nfrom = [0.0, 0.0]\nto = [0.0, 400.0]\n\
+        [[cushion]]\nfrom = [400.0, 400.0]\nto = [400.0, 0.0]\n";
+    assert!(parse(&(ball.clone() + open), SOURCE).is_ok());
+    let corner = "[[cushion]]\nfrom = [0.0, 0.0]\nto = [0.0, 400.0]\n\
+        [[cushion]]\nfrom = [0.0, 400.0]\nto = [400.0, 400.0]\n";
+    assert!(parse(&(ball + corner), SOURCE).is_ok());
+}
+
+/// A ball far beyond the others once made the overlap check index outside its buckets.
+#[test]
+fn a_ball_astronomically_far_away_is_an_error_or_runs_never_a_panic() {
+    let far = "[[ball]]\nposition = [100.0, 100.0]\nradius = 1.0\n\
+        [[ball]]\nposition = [1e30, 0.0]\nradius = 1.0\n";
+    assert!(
+        parse(far, SOURCE).is_ok(),
+        "an open table: nothing to be off"
+    );
+    let e = parse(&(far.to_string() + SQUARE), SOURCE).unwrap_err();
+    assert_eq!(e.field, "ball[2].position", "{e}");
+    assert!(e.message.contains("off the table"), "{e}");
+    let below = far.replace("[1e30, 0.0]", "[-1e300, -1e300]");
+    assert!(parse(&below, SOURCE).is_ok());
+}
+
+/// A scenario without balls is refused; a file without `[run]` runs to the default end time.
+#[test]
+fn a_scenario_needs_a_ball_and_defaults_its_end_time() {
+    for text in ["", "[run]\nuntil = 1.0\n", SQUARE] {
+        let e = parse(text, SOURCE).unwrap_err();
+        assert_eq!(e.field, "ball", "{e}");
+        assert!(e.message.contains("no balls"), "{e}");
+    }
+    let s = parse(&(ball_at(100.0, 100.0) + SQUARE), SOURCE).unwrap();
+    assert_eq!(s.until, poolsim::scenario::toml::DEFAULT_UNTIL);
+}
+
+/// An endless file is refused once it passes the bound, not read until memory runs out.
+#[cfg(unix)]
+#[test]
+fn an_endless_file_is_refused_at_the_bound() {
+    let e = load(std::path::Path::new("/dev/zero")).unwrap_err();
+    assert!(e.message.contains("over 1024 MiB"), "{e}");
+    assert!(!e.to_string().contains('\n'));
+}

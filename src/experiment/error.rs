@@ -15,9 +15,9 @@ pub enum ExperimentError {
     /// `--balls` given an empty list.
     #[error("--balls needs at least one number of balls")]
     NoBalls,
-    /// A number of balls that is not a square from 1 to 4096.
-    #[error("--balls: {0} is not a square number from 1 to 4096 (the gas is k x k balls)")]
-    NotSquare(usize),
+    /// A number of balls outside 1 to 4096.
+    #[error("--balls: {0} is not a whole number from 1 to 4096")]
+    BallsOutOfRange(usize),
     /// An option of the thesis experiment given to the reversal study.
     #[error(
         "{flag}: only the thesis experiment takes it (the reversal study has its own scenarios \

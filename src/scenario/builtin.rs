@@ -27,7 +27,7 @@ use std::f64::consts::PI;
 /// default. A scenario that has no use for a parameter rejects it, naming its flag.
 #[derive(Clone, Debug, Default)]
 pub struct Params {
-    /// `--balls N`: how many balls (gas: a square number).
+    /// `--balls N`: how many balls.
     pub balls: Option<usize>,
     /// `--seed S`: the seed of the random velocities (default 1).
     pub seed: Option<u64>,
@@ -286,16 +286,16 @@ fn plate1(p: &Params) -> Result<Scenario, Invalid> {
     })
 }
 
-/// The integer `k` with `k * k == n`, if there is one.
-fn exact_sqrt(n: usize) -> Option<usize> {
+/// The smallest `k` with `k * k >= n`: the side of the square grid that holds `n` sites.
+fn ceil_sqrt(n: usize) -> usize {
     let mut k = (n as f64).sqrt() as usize;
     while k.checked_mul(k).is_none_or(|kk| kk > n) {
         k -= 1;
     }
-    while (k + 1).checked_mul(k + 1).is_some_and(|kk| kk <= n) {
+    if k * k < n {
         k += 1;
     }
-    (k * k == n).then_some(k)
+    k
 }
 
 /// The best triangular lattice for `n` balls in a square: `(m, need)`, where `m` balls fill a
@@ -316,20 +316,20 @@ fn triangular_rows(n: usize) -> (usize, f64) {
     best
 }
 
-/// Centres of `n = k²` balls of radius `r` in the square `[0, side]²`, row by row from the
-/// bottom left: a square grid when its spacing `side / k` is at least `2r·(1 + 1e-9)`, else the
+/// Centres of `n` balls of radius `r` in the square `[0, side]²`, row by row from the bottom
+/// left: the first `n` sites of a `k × k` grid (`k² ≥ n`, the last sites empty when `n` is not a
+/// square) when its spacing `side / k` is at least `2r·(1 + 1e-9)`, else the
 /// densest triangular lattice of [`triangular_rows`]. `Err` holds the largest area fraction at
 /// which one of the two fits.
 fn lattice(n: usize, k: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
     let min_spacing = 2.0 * r * (1.0 + GAP);
     let s = side / k as f64;
     if s >= min_spacing {
-        let mut pts = Vec::with_capacity(n);
-        for j in 0..k {
-            for i in 0..k {
-                pts.push(Vec2::new((i as f64 + 0.5) * s, (j as f64 + 0.5) * s));
-            }
-        }
+        let sites = (0..k).flat_map(|j| (0..k).map(move |i| (i, j)));
+        let pts = sites
+            .take(n)
+            .map(|(i, j)| Vec2::new((i as f64 + 0.5) * s, (j as f64 + 0.5) * s))
+            .collect();
         return Ok(pts);
     }
     let (m, need) = triangular_rows(n);
@@ -355,8 +355,9 @@ fn lattice(n: usize, k: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
     Ok(pts)
 }
 
-/// The thesis' gas (chapter 6): `k × k` equal balls with random velocities on a square table of
-/// four perfectly elastic cushions, no pockets.
+/// The thesis' gas (chapter 6): `N` equal balls with random velocities on a square table of
+/// four perfectly elastic cushions, no pockets, on the first `N` sites of the smallest `k × k`
+/// grid that holds them (all of it when `N` is a square, as in the thesis).
 ///
 /// The side is `100 k` (the thesis' 600 × 600 for 36 balls) or, with `--area-fraction PHI`,
 /// `sqrt(N π r² / PHI)`. Velocities are drawn ball by ball in ball order.
@@ -366,15 +367,10 @@ fn gas(p: &Params) -> Result<Scenario, Invalid> {
     if n == 0 || n > MAX_BALLS {
         return Err(bad(
             BALLS,
-            format!("must be a square number from 1 to {MAX_BALLS}, got {n}"),
+            format!("must be a whole number from 1 to {MAX_BALLS}, got {n}"),
         ));
     }
-    let k = exact_sqrt(n).ok_or_else(|| {
-        bad(
-            BALLS,
-            format!("must be a square number (the gas is k x k balls), got {n}"),
-        )
-    })?;
+    let k = ceil_sqrt(n);
     let r = radius_param(p, GAS_RADIUS)?;
     let vmax = speed_param(p, GAS_SPEED)?;
     let side = match p.area_fraction {
@@ -731,12 +727,32 @@ mod tests {
     }
 
     #[test]
-    fn gas_balls_must_be_a_square() {
-        let e = gas_with(10, 1, None).unwrap_err();
+    fn a_gas_takes_any_number_of_balls() {
+        // 10 balls: the first 10 sites of the 4 x 4 grid of a 400 x 400 table
+        let s = gas_with(10, 1, None).unwrap();
+        assert_eq!(s.balls.len(), 10);
+        assert_eq!(s.bounds().1, Vec2::new(400.0, 400.0));
+        assert_eq!(s.balls[9].position, Vec2::new(150.0, 250.0));
+        s.validate().unwrap();
+        // the square numbers keep the thesis' k x k grid, and the dense ones still fit
+        assert_eq!(
+            gas_with(16, 1, None).unwrap().balls[4].position,
+            Vec2::new(50.0, 150.0)
+        );
+        for (n, phi) in [
+            (2, None),
+            (3, Some(0.3)),
+            (5, None),
+            (99_999, Some(0.5)),
+            (100_001, Some(0.5)),
+        ] {
+            let s = gas_with(n, 1, phi).unwrap();
+            assert_eq!(s.balls.len(), n);
+            s.validate().unwrap();
+        }
+        let e = gas_with(0, 1, None).unwrap_err();
+        assert!(e.message.contains("whole number from 1"), "{}", e.message);
         assert_eq!(e.field, "--balls");
-        assert!(e.message.contains("square number"), "{}", e.message);
-        assert!(e.message.contains("got 10"), "{}", e.message);
-        assert_eq!(gas_with(0, 1, None).unwrap_err().field, "--balls");
         assert_eq!(gas_with(usize::MAX, 1, None).unwrap_err().field, "--balls");
         assert_eq!(gas_with(1, 1, None).unwrap().balls.len(), 1);
     }
@@ -894,12 +910,19 @@ mod tests {
     }
 
     #[test]
-    fn exact_square_roots() {
-        assert_eq!(exact_sqrt(1), Some(1));
-        assert_eq!(exact_sqrt(36), Some(6));
-        assert_eq!(exact_sqrt(35), None);
-        assert_eq!(exact_sqrt(1_000_000), Some(1000));
-        assert_eq!(exact_sqrt(usize::MAX), None);
-        assert_eq!(exact_sqrt(0), Some(0));
+    fn ceiling_square_roots() {
+        let cases = [
+            (1, 1),
+            (2, 2),
+            (4, 2),
+            (35, 6),
+            (36, 6),
+            (37, 7),
+            (1_000_000, 1000),
+        ];
+        for (n, k) in cases {
+            assert_eq!(ceil_sqrt(n), k, "{n}");
+        }
+        assert_eq!(ceil_sqrt(0), 0);
     }
 }

@@ -234,6 +234,12 @@ impl Scenario {
     /// Checks every rule engines rely on; the first broken one is returned with its field path.
     /// Overlap is found with a sort along x, so validation of a million balls stays fast.
     pub fn validate(&self) -> Result<(), Invalid> {
+        if self.balls.is_empty() {
+            return Err(invalid(
+                "ball".into(),
+                "the scenario has no balls: give at least one `[[ball]]`".into(),
+            ));
+        }
         check_finite("run.until", self.until)?;
         if self.until < 0.0 {
             return Err(invalid(
@@ -273,8 +279,8 @@ impl Scenario {
             check_segment(&f, p.from, p.to)?;
             check_elasticity(&format!("{f}.corner_elasticity"), p.corner_elasticity)?;
         }
-        self.check_overlaps()?;
         self.check_on_table()?;
+        self.check_overlaps()?;
         self.check_sectors()
     }
 
@@ -292,11 +298,12 @@ impl Scenario {
             .collect();
         sorted.sort_unstable();
         for (i, bi) in self.balls.iter().enumerate() {
+            // far-off centres saturate the cell numbers: the neighbours' numbers must too
             let (cy, cx) = cell(bi.position);
             let mut worst: Option<usize> = None;
-            for y in cy - 1..=cy + 1 {
-                let lo = sorted.partition_point(|e| e.0 < (y, cx - 1));
-                let hi = sorted.partition_point(|e| e.0 <= (y, cx + 1));
+            for y in cy.saturating_sub(1)..=cy.saturating_add(1) {
+                let lo = sorted.partition_point(|e| e.0 < (y, cx.saturating_sub(1)));
+                let hi = sorted.partition_point(|e| e.0 <= (y, cx.saturating_add(1)));
                 for &(_, j) in &sorted[lo..hi] {
                     if j <= i {
                         continue;
@@ -362,18 +369,53 @@ impl Scenario {
         Ok(())
     }
 
-    /// The table's edges if they close into loops (every edge ends where another begins); `None`
-    /// where they leave gaps: an open table has no inside to check balls against.
+    /// The table's edges if they close into loops (every end of an edge meets an end of another,
+    /// whichever way each runs); `None` where they leave gaps: an open table has no inside to
+    /// check balls against.
     fn closed_edges(&self) -> Option<Vec<(Vec2, Vec2)>> {
         let edges = self.edges();
         let (lo, hi) = self.bounds();
         let tol = 1e-9 * (hi - lo).norm();
+        let meets = |k: usize, p: Vec2| {
+            edges
+                .iter()
+                .enumerate()
+                .any(|(j, &(a, b))| j != k && ((a - p).norm() <= tol || (b - p).norm() <= tol))
+        };
         let closed = edges.len() >= 3
             && edges.len() <= 4096
             && edges
                 .iter()
-                .all(|&(_, to)| edges.iter().any(|&(from, _)| (from - to).norm() <= tol));
+                .enumerate()
+                .all(|(k, &(from, to))| meets(k, from) && meets(k, to));
         closed.then_some(edges)
+    }
+
+    /// On a closed table every cushion and pocket mouth must have the table on its right: the
+    /// point just to the right of its middle lies inside the loops. One wound the wrong way
+    /// would be met from behind, and a ball would pass through it.
+    fn check_each_winding(&self, loops: &[(Vec2, Vec2)]) -> Result<(), Invalid> {
+        let (lo, hi) = self.bounds();
+        let step = 1e-7 * (hi - lo).norm();
+        let wrong = loops.iter().position(|&(a, b)| {
+            let along = b - a;
+            let right = (1.0 / along.norm()) * along.perp_cw();
+            !encloses(loops, 0.5 * (a + b) + step * right)
+        });
+        let Some(k) = wrong else {
+            return Ok(());
+        };
+        let (field, what) = match k.checked_sub(self.cushions.len()) {
+            None => (format!("cushion[{}]", k + 1), "cushion"),
+            Some(p) => (format!("pocket[{}]", p + 1), "pocket"),
+        };
+        Err(invalid(
+            field,
+            format!(
+                "this {what} runs the wrong way: the table must lie on its right going from \
+                 `from` to `to` (swap its from and to)"
+            ),
+        ))
     }
 
     fn check_on_table(&self) -> Result<(), Invalid> {
@@ -383,6 +425,9 @@ impl Scenario {
         self.check_winding()?;
         let (lo, hi) = self.bounds();
         let loops = self.closed_edges();
+        if let Some(loops) = &loops {
+            self.check_each_winding(loops)?;
+        }
         for (i, b) in self.balls.iter().enumerate() {
             let p = b.position;
             let field = || format!("ball[{}].position", i + 1);

@@ -31,6 +31,7 @@ use ::toml::Spanned;
 use serde::de::{self, IgnoredAny, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::fmt;
+use std::io::Read;
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::path::Path;
@@ -60,20 +61,32 @@ pub fn parse(text: &str, source: &str) -> Result<Scenario, ScenarioError> {
     Ok(scenario)
 }
 
+/// The most a scenario file may hold: a million balls take about a tenth of it.
+pub const MAX_SCENARIO_BYTES: u64 = 1 << 30;
+
 /// Reads a file and parses it with [`parse`], naming the file by its path.
 ///
-/// I/O errors (a missing file, text that is not UTF-8) become a [`ScenarioError`] with no line
-/// and an empty field.
+/// I/O errors (a missing file, text that is not UTF-8, a file over [`MAX_SCENARIO_BYTES`],
+/// which bounds what reading `/dev/zero` may take) become a [`ScenarioError`] with no line and
+/// an empty field.
 pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
     let source = path.display().to_string();
-    match std::fs::read_to_string(path) {
-        Ok(text) => parse(&text, &source),
-        Err(e) => Err(ScenarioError {
-            source,
-            line: None,
-            field: String::new(),
-            message: one_line(&format!("cannot read the file: {e}")),
-        }),
+    let fail = |message: String| ScenarioError {
+        source: source.clone(),
+        line: None,
+        field: String::new(),
+        message: one_line(&message),
+    };
+    let mut text = String::new();
+    let read = std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_string(&mut text));
+    match read {
+        Err(e) => Err(fail(format!("cannot read the file: {e}"))),
+        Ok(n) if n as u64 > MAX_SCENARIO_BYTES => Err(fail(format!(
+            "the file is over {} MiB, more than a scenario may hold",
+            MAX_SCENARIO_BYTES >> 20
+        ))),
+        Ok(_) => parse(&text, &source),
     }
 }
 
@@ -597,6 +610,11 @@ grid = [2, 3]
         lines.join("\n") + "\n"
     }
 
+    /// A closed unit square of cushions, to follow a text whose sectors cover it.
+    const UNIT_SQUARE: &str =
+        "[[cushion]]\nfrom = [0, 0]\nto = [0, 1]\n[[cushion]]\nfrom = [0, 1]\nto = [1, 1]\n\
+        [[cushion]]\nfrom = [1, 1]\nto = [1, 0]\n[[cushion]]\nfrom = [1, 0]\nto = [0, 0]\n";
+
     fn fails(text: &str) -> ScenarioError {
         match parse(text, "t.toml") {
             Ok(_) => panic!("expected an error for:\n{text}"),
@@ -660,19 +678,23 @@ grid = [2, 3]
         assert_eq!(s.balls[0].mass, 1.0);
         assert!(s.cushions.is_empty() && s.pockets.is_empty() && s.sectors.is_none());
         let s = parse(
-            "[[pocket]]\nfrom = [0, 1]\nto = [0, 0]\n[[cushion]]\nfrom = [0, 0]\nto = [0, 1]\n",
+            "[[pocket]]\nfrom = [0, 0]\nto = [0, 1]\n[[cushion]]\nfrom = [2, 1]\nto = [2, 0]\n\
+             [[ball]]\nposition = [1, 0.5]\nradius = 0.1\n",
             "d.toml",
         )
         .unwrap();
         assert_eq!(s.pockets[0].corner_elasticity, 1.0);
         assert_eq!(s.cushions[0].elasticity, 1.0);
-        assert_eq!(parse("", "e.toml").unwrap().balls.len(), 0);
+        assert_eq!(fails("").field, "ball");
     }
 
     #[test]
     fn polygon_sectors_round_trip() {
-        let text = "[[sectors.polygon]]\npoints = [[0, 0], [0, 1], [1, 1]]\n\
-                    [[sectors.polygon]]\npoints = [\n  [1, 1],\n  [1, 0], # comment\n  [0, 0],\n]\n";
+        let text = &("[[sectors.polygon]]\npoints = [[0, 0], [0, 1], [1, 1]]\n\
+                    [[sectors.polygon]]\npoints = [\n  [1, 1],\n  [1, 0], # comment\n  [0, 0],\n]\n\
+                    [[ball]]\nposition = [0.5, 0.5]\nradius = 0.1\n"
+            .to_string()
+            + UNIT_SQUARE);
         let s = parse(text, "p.toml").unwrap();
         let Some(SectorSpec::Polygons(polys)) = s.sectors else {
             panic!("no polygons")
@@ -836,8 +858,11 @@ grid = [2, 3]
         assert_error(&e, 37, "sectors", "not both");
         let e = fails(&with_line(37, "# no grid"));
         assert_error(&e, 36, "sectors", "needs grid");
-        let text = "[[sectors.polygon]]\npoints = [[0, 0], [0, 1], [1, 1]]\n\
-                    [[sectors.polygon]]\npoints = [\n  [0, 0],\n  [1, 1],\n]\n";
+        let text = &("[[sectors.polygon]]\npoints = [[0, 0], [0, 1], [1, 1]]\n\
+                    [[sectors.polygon]]\npoints = [\n  [0, 0],\n  [1, 1],\n]\n\
+                    [[ball]]\nposition = [0.5, 0.5]\nradius = 0.1\n"
+            .to_string()
+            + UNIT_SQUARE);
         let e = fails(text);
         assert_error(&e, 4, "sectors.polygon[2].points", "at least 3 points");
     }

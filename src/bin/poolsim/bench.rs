@@ -10,11 +10,11 @@ use poolsim::bench::{
 /// Arguments of `poolsim bench`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct BenchArgs {
-    /// Ball counts (each rounded to a square number).
+    /// Ball counts.
     #[arg(
         long,
         value_delimiter = ',',
-        default_value = "1000,10000,100000,1000000"
+        default_value = "1024,10000,99856,1000000"
     )]
     pub balls: Vec<usize>,
     /// Area fractions.

@@ -10,7 +10,7 @@ use std::io::IsTerminal;
 /// Parameters of generated scenarios.
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct GenArgs {
-    /// Number of balls (gas: a square number).
+    /// Number of balls.
     #[arg(long)]
     pub balls: Option<usize>,
     /// Random seed of generated scenarios.

@@ -29,7 +29,7 @@ pub struct ExperimentArgs {
     /// Seeds per cell, 1..=S (default 6, as the thesis ran its non-sectored cases; 2 with --quick).
     #[arg(long)]
     pub seeds: Option<u64>,
-    /// Numbers of balls, comma separated square numbers (default 4,16,36,64; 4,16 with --quick).
+    /// Numbers of balls, comma separated (default 4,16,36,64; 4,16 with --quick).
     #[arg(long, value_delimiter = ',')]
     pub balls: Option<Vec<usize>>,
     /// A reduced grid for CI: 4 and 16 balls, 2 seeds, until 4.

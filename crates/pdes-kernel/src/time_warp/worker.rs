@@ -142,6 +142,7 @@ impl<T: Time, Msg, State> Default for Spare<T, Msg, State> {
 }
 
 /// A spare vector, or a new one.
+#[inline]
 fn take<T>(pool: &mut Vec<Vec<T>>) -> Vec<T> {
     pool.pop().unwrap_or_default()
 }
@@ -168,6 +169,7 @@ fn not_before<T: Time>(h: &Handle, at: VTime<T>, by: u32) -> VTime<T> {
 }
 
 /// Keeps `v`, emptied, for another batch.
+#[inline]
 fn give<T>(pool: &mut Vec<Vec<T>>, mut v: Vec<T>) {
     if pool.len() < SPARE && v.capacity() > 0 {
         v.clear();
