@@ -84,7 +84,7 @@ impl ModelParams {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ModelError {
     /// `N` is not a whole number from 1 to [`MAX_BALLS`].
-    #[error("--balls must be a whole number from 1 to {MAX_BALLS:e}, got {0:?}")]
+    #[error("--balls must be a whole number from 1 to {MAX_BALLS:e}, got {0}")]
     Balls(f64),
     /// `V` or `T` is not a finite positive number.
     #[error("{flag} must be a positive number, got {value:?}")]
@@ -443,7 +443,7 @@ mod tests {
         assert_eq!(bad.validate(), Err(ModelError::Balls(0.0)));
         assert_eq!(
             bad.validate().unwrap_err().to_string(),
-            "--balls must be a whole number from 1 to 1e15, got 0.0"
+            "--balls must be a whole number from 1 to 1e15, got 0"
         );
         assert!(optimal_sector(&bad).is_nan());
         assert!(report_json(&bad)["error"].is_string());

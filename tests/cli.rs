@@ -898,3 +898,64 @@ fn outputs_that_would_destroy_inputs_and_endless_time_steps_are_refused() {
     let line = bad_usage(&["run", s, "--engine", "time-step", "--dt", "1e-300"]);
     assert!(line.contains("--dt") && line.contains("steps"), "{line}");
 }
+
+/// Unix habits: `-` reads the scenario from stdin and writes the trace to stdout (the summary
+/// then goes to stderr); `--quiet` drops the human summary but not `--json`.
+#[test]
+fn dash_means_stdin_and_stdout_and_quiet_means_quiet() {
+    let file = manifest_dir().join("scenarios/fig11_three_ball.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_poolsim"))
+        .args(["run", "-", "--trace", "-", "--json"])
+        .stdin(std::fs::File::open(&file).unwrap())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let trace = text(&out.stdout);
+    let lines: Vec<Value> = trace
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert!(!lines.is_empty() && lines.iter().all(|l| l["kind"].is_string()));
+    let summary: Value = serde_json::from_str(text(&out.stderr).trim()).unwrap();
+    assert_eq!(summary["scenario"], "stdin");
+    assert_eq!(u(&summary["events"]["total"]), lines.len() as u64);
+    assert_eq!(success(&["run", "plate1", "--quiet"]), "");
+    assert_eq!(
+        success_json(&["run", "plate1", "--quiet", "--json"])["scenario"],
+        "plate1"
+    );
+    // an empty stdin is a scenario without balls
+    let e = bad_usage(&["run", "-"]);
+    assert!(e.contains("stdin: ball: the scenario has no balls"), "{e}");
+}
+
+/// Flags are named as the user gave them, and only engines that take a flag accept it.
+#[test]
+fn flags_are_named_as_given() {
+    let e = bad_usage(&["phold", "--objects", "0"]);
+    assert!(e.contains("--objects: must be at least 1"), "{e}");
+    let e = bad_usage(&["phold", "--objects", "4", "--partitions", "9"]);
+    assert!(
+        e.contains("--partitions: must be from 1 to --objects (4), got 9"),
+        "{e}"
+    );
+    let e = bad_usage(&["model", "--balls", "0"]);
+    assert!(e.ends_with("got 0"), "{e}");
+    let e = bad_usage(&["reverse", "reversal", "--quit", "3", "--workers", "2"]);
+    assert!(
+        e.contains("--workers: only the time-warp engine takes it"),
+        "{e}"
+    );
+    let r = success_json(&[
+        "reverse",
+        "reversal",
+        "--quit",
+        "3",
+        "--engine",
+        "time-warp",
+        "--workers",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(r["engine"], "time-warp", "{r}");
+}

@@ -544,9 +544,12 @@ fn pts_empty(lo: Vec2) -> bool {
     !lo.x.is_finite()
 }
 
-/// Loads a scenario by built-in name or TOML path. Generator parameters (`params`) are only
-/// accepted by built-ins that use them; a file takes none.
+/// Loads a scenario by built-in name, TOML path, or `-` for TOML on stdin. Generator parameters
+/// (`params`) are only accepted by built-ins that use them; a file takes none.
 pub fn load(spec: &str, params: &builtin::Params) -> Result<Scenario, ScenarioError> {
+    if spec == "-" {
+        return toml::load_from(std::io::stdin().lock(), "stdin");
+    }
     let is_builtin = builtin::list().iter().any(|(name, _)| *name == spec);
     // an error about the name itself, not about a field
     let about_name = |message: String| ScenarioError {

@@ -71,22 +71,39 @@ pub const MAX_SCENARIO_BYTES: u64 = 1 << 30;
 /// an empty field.
 pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
     let source = path.display().to_string();
-    let fail = |message: String| ScenarioError {
-        source: source.clone(),
+    match std::fs::File::open(path) {
+        Ok(file) => load_from(file, &source),
+        Err(e) => Err(io_error(&source, format!("cannot read the file: {e}"))),
+    }
+}
+
+/// Reads scenario text from `reader` (a file, stdin) and parses it with [`parse`]; `source`
+/// names it in errors. Reads at most [`MAX_SCENARIO_BYTES`].
+pub fn load_from(reader: impl Read, source: &str) -> Result<Scenario, ScenarioError> {
+    let mut text = String::new();
+    match reader
+        .take(MAX_SCENARIO_BYTES + 1)
+        .read_to_string(&mut text)
+    {
+        Err(e) => Err(io_error(source, format!("cannot read the file: {e}"))),
+        Ok(n) if n as u64 > MAX_SCENARIO_BYTES => Err(io_error(
+            source,
+            format!(
+                "the file is over {} MiB, more than a scenario may hold",
+                MAX_SCENARIO_BYTES >> 20
+            ),
+        )),
+        Ok(_) => parse(&text, source),
+    }
+}
+
+/// An error reading `source`, before any line of it is known.
+fn io_error(source: &str, message: String) -> ScenarioError {
+    ScenarioError {
+        source: source.to_string(),
         line: None,
         field: String::new(),
         message: one_line(&message),
-    };
-    let mut text = String::new();
-    let read = std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_string(&mut text));
-    match read {
-        Err(e) => Err(fail(format!("cannot read the file: {e}"))),
-        Ok(n) if n as u64 > MAX_SCENARIO_BYTES => Err(fail(format!(
-            "the file is over {} MiB, more than a scenario may hold",
-            MAX_SCENARIO_BYTES >> 20
-        ))),
-        Ok(_) => parse(&text, &source),
     }
 }
 

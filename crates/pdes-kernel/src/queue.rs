@@ -309,7 +309,7 @@ impl<T: Ranked> Queue<T> {
     }
 
     /// The next item.
-    #[inline]
+    #[inline(always)]
     pub fn peek(&mut self) -> Option<&T> {
         let later = self.later_first();
         self.peeked_later = Some(later);

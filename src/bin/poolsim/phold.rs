@@ -108,11 +108,21 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
             a.objects, a.events_per_object
         )));
     }
-    if a.objects == 0 || partitions == 0 || partitions > a.objects {
-        return Err(usage(format!(
-            "--objects and --partitions: need 1 <= partitions <= objects, got {} and {}",
-            partitions, a.objects
-        )));
+    if a.objects == 0 {
+        return Err(usage("--objects: must be at least 1, got 0"));
+    }
+    if partitions == 0 || partitions > a.objects {
+        return Err(usage(match a.partitions {
+            Some(p) => format!(
+                "--partitions: must be from 1 to --objects ({}), got {p}",
+                a.objects
+            ),
+            None => format!(
+                "--objects: {} is fewer than the {partitions} partitions of the workers; give \
+                 more objects or --partitions",
+                a.objects
+            ),
+        }));
     }
     let report = run(
         PholdConfig {

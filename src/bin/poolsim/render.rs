@@ -11,7 +11,7 @@ use std::path::PathBuf;
 /// Arguments of `poolsim render`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct RenderArgs {
-    /// A built-in scenario name or a TOML file.
+    /// A built-in scenario name, a TOML file, or - for TOML on stdin.
     pub scenario: String,
     /// A folder (frame-0000.svg and .png, ...), FILE.html (one page with a player) or FILE.gif.
     #[arg(long)]
@@ -134,7 +134,7 @@ pub fn demo(json: bool, out: &std::path::Path) -> Result<(), Failure> {
         println!("{}", serde_json::to_string(&demo).expect("plain data"));
         return Ok(());
     }
-    print_summary(&rec.summary, false);
+    print!("{}", human_summary(&rec.summary));
     {
         let m = &rec.summary.messages;
         println!(

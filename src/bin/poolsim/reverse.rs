@@ -7,7 +7,7 @@ use crate::values::{Delay, Engine, Sectors};
 /// Arguments of `poolsim reverse`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct ReverseArgs {
-    /// A built-in scenario name or a TOML file; its balls are placed at time -Q.
+    /// A built-in scenario name, a TOML file, or - for TOML on stdin. its balls are placed at time -Q.
     pub scenario: String,
     /// Quitting time Q.
     #[arg(long, allow_negative_numbers = true)]
@@ -20,6 +20,9 @@ pub struct ReverseArgs {
     pub sectors: Option<Sectors>,
     #[command(flatten)]
     pub gen: GenArgs,
+    /// Worker threads (time-warp engine; default: this machine's cores).
+    #[arg(long)]
+    pub workers: Option<usize>,
     /// Time step of the time-step engine.
     #[arg(long, allow_negative_numbers = true)]
     pub dt: Option<f64>,
@@ -46,6 +49,7 @@ pub fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
         json: a.json,
         check: a.check,
         dt: a.dt,
+        workers: a.workers,
         ..RunArgs::for_engine(
             &a.scenario,
             a.engine,
@@ -55,6 +59,7 @@ pub fn reverse(a: &ReverseArgs) -> Result<(), Failure> {
         )
     };
     let engine = engine_of(&run_args, &scenario)?;
+    check_options_fit(&run_args, &engine)?;
     let r = poolsim::run::reverse(&scenario, engine, a.quit, a.check).map_err(run_failure)?;
     if a.json {
         println!(

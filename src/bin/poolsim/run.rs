@@ -10,12 +10,12 @@ use poolsim::run::{execute, EngineKind, RunConfig};
 use poolsim::scenario::Scenario;
 use poolsim::summary::RunSummary;
 use std::fs::File;
-use std::io::BufWriter;
+use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct RunArgs {
-    /// A built-in scenario name (see `poolsim scenarios`) or a TOML file.
+    /// A built-in scenario name (see `poolsim scenarios`), a TOML file, or - for TOML on stdin.
     pub scenario: String,
     /// The engine.
     #[arg(long, value_enum, default_value = "event-list")]
@@ -28,7 +28,8 @@ pub struct RunArgs {
     pub until: Option<f64>,
     #[command(flatten)]
     pub gen: GenArgs,
-    /// Write the trace (JSON Lines, one line per physical event) here.
+    /// Write the trace (JSON Lines, one line per physical event) here; `-` writes it to stdout,
+    /// and the summary then goes to stderr.
     #[arg(long)]
     pub trace: Option<PathBuf>,
     /// Write the final state (JSON) here.
@@ -67,7 +68,7 @@ pub struct RunArgs {
     /// Time step of the time-step engine.
     #[arg(long, allow_negative_numbers = true)]
     pub dt: Option<f64>,
-    /// No progress bar.
+    /// No progress bar and no human summary (`--json` still prints).
     #[arg(long)]
     pub quiet: bool,
 }
@@ -204,8 +205,10 @@ pub fn check_outputs_apart(a: &RunArgs) -> Result<(), Failure> {
             Some(dir.canonicalize().ok()?.join(p.file_name()?))
         })
     };
+    // `-` is stdin or stdout, never a file
     let same = |x: &std::path::Path, y: &std::path::Path| {
-        resolved(x).is_some_and(|x| resolved(y) == Some(x))
+        let named = |p: &std::path::Path| p.as_os_str() != "-";
+        named(x) && named(y) && resolved(x).is_some_and(|x| resolved(y) == Some(x))
     };
     let scenario = std::path::Path::new(&a.scenario);
     for (flag, out) in [("--trace", &a.trace), ("--final-state", &a.final_state)] {
@@ -230,7 +233,7 @@ pub fn check_outputs_apart(a: &RunArgs) -> Result<(), Failure> {
 }
 
 /// Refuses options the chosen engine does not take.
-fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure> {
+pub fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure> {
     let objects = !matches!(engine, EngineKind::EventList | EngineKind::TimeStep { .. });
     let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
     let sectored = matches!(
@@ -304,14 +307,7 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
     // under MPI only rank 0 writes anything
     let root = pdes_kernel::time_warp::threads::collects_results();
     let mut trace = match a.trace.as_ref().filter(|_| root) {
-        Some(p) => Some(TraceWriter::new(BufWriter::new(File::create(p).map_err(
-            |e| {
-                usage(format!(
-                    "{}: cannot create the trace file: {e}",
-                    p.display()
-                ))
-            },
-        )?))),
+        Some(p) => Some(TraceWriter::new(trace_file(p)?)),
         None => None,
     };
     let mut progress = Progress::new(until, a.quiet || !root);
@@ -346,8 +342,36 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
     if let Some(p) = &a.final_state {
         write_final_state(p, &report.outcome)?;
     }
-    print_summary(&report.summary, a.json);
+    // with the trace on stdout, the summary goes to stderr
+    let to_stdout = a.trace.as_ref().is_none_or(|p| p.as_os_str() != "-");
+    if a.json || !a.quiet {
+        let summary = if a.json {
+            serde_json::to_string(&report.summary).expect("plain data") + "\n"
+        } else {
+            human_summary(&report.summary)
+        };
+        let written = if to_stdout {
+            std::io::stdout().write_all(summary.as_bytes())
+        } else {
+            std::io::stderr().write_all(summary.as_bytes())
+        };
+        written.map_err(|e| usage(format!("writing the summary failed: {e}")))?;
+    }
     Ok(())
+}
+
+/// Where the trace goes: the file at `p`, or stdout for `-`.
+fn trace_file(p: &std::path::Path) -> Result<BufWriter<Box<dyn Write>>, Failure> {
+    if p.as_os_str() == "-" {
+        return Ok(BufWriter::new(Box::new(std::io::stdout())));
+    }
+    let file = File::create(p).map_err(|e| {
+        usage(format!(
+            "{}: cannot create the trace file: {e}",
+            p.display()
+        ))
+    })?;
+    Ok(BufWriter::new(Box::new(file)))
 }
 
 /// Writes the final state of `outcome` to `p` as pretty JSON.
@@ -388,44 +412,41 @@ impl<W: std::io::Write> Observer for Sinks<'_, W> {
     }
 }
 
-pub fn print_summary(s: &RunSummary, json: bool) {
-    if json {
-        println!("{}", serde_json::to_string(s).expect("plain data"));
-        return;
-    }
-    println!("scenario      {}", s.scenario);
-    println!("engine        {}", s.engine);
-    println!("balls         {}", s.balls);
-    println!("until         {:?}", s.until);
+/// The summary as the human reads it, one line per item.
+pub fn human_summary(s: &RunSummary) -> String {
     let ev = &s.events;
-    println!(
-        "events        {} (ball-ball {}, ball-cushion {}, ball-corner {}, ball-pocket {})",
-        ev.total, ev.ball_ball, ev.ball_cushion, ev.ball_corner, ev.ball_pocket
-    );
     let ke = &s.kinetic_energy;
-    println!(
-        "energy        initial {:?}, final {:?} on the table + {:?} in pockets (relative drift {:e})",
-        ke.initial, ke.end, ke.pocketed, ke.relative_drift
-    );
-    println!("digest        {}", s.final_state_digest);
-    println!(
-        "wall          {:.3} s ({:.3} s set-up), {:.0} events/s{}",
-        s.wall_seconds,
-        s.setup_seconds,
-        s.events_per_second,
-        if s.checked {
-            ", invariants checked at every event"
-        } else {
-            ""
-        }
-    );
+    let checked = if s.checked {
+        ", invariants checked at every event"
+    } else {
+        ""
+    };
+    let mut lines = vec![
+        format!("scenario      {}", s.scenario),
+        format!("engine        {}", s.engine),
+        format!("balls         {}", s.balls),
+        format!("until         {:?}", s.until),
+        format!(
+            "events        {} (ball-ball {}, ball-cushion {}, ball-corner {}, ball-pocket {})",
+            ev.total, ev.ball_ball, ev.ball_cushion, ev.ball_corner, ev.ball_pocket
+        ),
+        format!(
+            "energy        initial {:?}, final {:?} on the table + {:?} in pockets (relative drift {:e})",
+            ke.initial, ke.end, ke.pocketed, ke.relative_drift
+        ),
+        format!("digest        {}", s.final_state_digest),
+        format!(
+            "wall          {:.3} s ({:.3} s set-up), {:.0} events/s{checked}",
+            s.wall_seconds, s.setup_seconds, s.events_per_second
+        ),
+    ];
     if let Some(tw) = &s.time_warp {
         let st = &tw.stats;
         let count = |n: u64, one: &str| match n {
             1 => format!("1 {one}"),
             m => format!("{m} {one}s"),
         };
-        println!(
+        lines.push(format!(
             "time warp     {} on {}: efficiency {:.3}, {:.0} % of batches final, {} rollbacks, \
              {:.2} % of messages remote, {} GVT rounds",
             count(st.workers, "worker"),
@@ -435,6 +456,7 @@ pub fn print_summary(s: &RunSummary, json: bool) {
             st.rollbacks,
             100.0 * tw.remote_fraction,
             st.gvt_rounds
-        );
+        ));
     }
+    lines.join("\n") + "\n"
 }

@@ -142,7 +142,7 @@ impl<T: Time, Msg, State> Default for Spare<T, Msg, State> {
 }
 
 /// A spare vector, or a new one.
-#[inline]
+#[inline(always)]
 fn take<T>(pool: &mut Vec<Vec<T>>) -> Vec<T> {
     pool.pop().unwrap_or_default()
 }
@@ -169,7 +169,7 @@ fn not_before<T: Time>(h: &Handle, at: VTime<T>, by: u32) -> VTime<T> {
 }
 
 /// Keeps `v`, emptied, for another batch.
-#[inline]
+#[inline(always)]
 fn give<T>(pool: &mut Vec<Vec<T>>, mut v: Vec<T>) {
     if pool.len() < SPARE && v.capacity() > 0 {
         v.clear();
@@ -670,6 +670,7 @@ impl<M: Model> Worker<M> {
     }
 
     /// The smallest time of a live message waiting here (marked ones taken off the heap).
+    #[inline(always)]
     fn next_time(&mut self) -> Option<f64> {
         loop {
             let top = self.heap.peek()?;
@@ -735,6 +736,7 @@ impl<M: Model> Worker<M> {
 
     /// Runs the next batch if its time is at most `limit` (and, when `final_only`, if it may
     /// run as final); false when there is none.
+    #[inline(always)]
     fn step<F: Fabric<M>>(&mut self, model: &M, fabric: &F, limit: f64, final_only: bool) -> bool {
         match self.next_time() {
             Some(t) if t <= limit => {}
@@ -1425,7 +1427,7 @@ impl<M: Model> Worker<M> {
 
     /// Runs a burst of batches up to `limit`: how many ran, and whether the worker was held
     /// back to final batches (more than `ahead` uncommitted).
-    #[inline]
+    #[inline(always)]
     fn burst<F: Fabric<M>>(
         &mut self,
         model: &M,
