@@ -69,9 +69,26 @@ pub struct BenchReport {
     pub phold_ross_events_per_second_per_core: f64,
 }
 
-/// One result as soon as it is measured, for a caller that shows them as they come.
+/// The parts of a bench, in the order they run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    /// The event-list rows.
+    EventList,
+    /// The plain and sectored objects engine rows.
+    Objects,
+    /// The Time Warp rows: a program that runs the objects engines without transparent huge
+    /// pages ([`crate::memory`]) turns them off here.
+    TimeWarp,
+    /// PHOLD on the kernel.
+    Phold,
+}
+
+/// One result as soon as it is measured, for a caller that shows them as they come, and the
+/// start of each part, for a caller that sets the process up for it.
 #[derive(Clone, Copy, Debug)]
 pub enum Measured<'a> {
+    /// A part of the bench starts.
+    Starting(Part),
     /// An event-list row.
     Row(&'a BenchRow),
     /// The event-list rows' growth, after the last of them.
@@ -407,6 +424,7 @@ fn validate(a: &BenchOptions) -> Result<usize, BenchError> {
 /// Measures everything `a` asks for, handing each result to `each` as soon as it is measured.
 pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchReport, BenchError> {
     let partitions = validate(a)?;
+    each(Measured::Starting(Part::EventList));
     let mut rows = Vec::new();
     for &n in &a.balls {
         for &phi in &a.area_fractions {
@@ -421,6 +439,7 @@ pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchRepo
     }
     let growth = growth(&rows);
     each(Measured::Growth(&growth));
+    each(Measured::Starting(Part::Objects));
     let objects_row = |n: usize, sectors: Option<crate::run::SectorChoice>| {
         fastest(
             a.repeat,
@@ -440,6 +459,7 @@ pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchRepo
         each(Measured::Sectored(&r));
         sectored.push(r);
     }
+    each(Measured::Starting(Part::TimeWarp));
     let mut time_warp = Vec::new();
     for &n in &a.tw_balls {
         let mut runs = Vec::new();
@@ -451,6 +471,7 @@ pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchRepo
             time_warp.push(r);
         }
     }
+    each(Measured::Starting(Part::Phold));
     let phold = measure_phold(a, partitions as u32, each)?;
     Ok(BenchReport {
         machine: machine(),
@@ -599,21 +620,8 @@ pub struct TwRow {
 
 /// Runs the sectored gas (`--sectors auto`) of `balls` balls until `until` on the sequential
 /// objects engine and under Time Warp on each of `workers` (`pure`: no batch run as final);
-/// fails if any digest differs. All of them run without transparent huge pages, as
-/// `poolsim run` runs the objects engines ([`crate::memory`]).
+/// fails if any digest differs.
 pub fn measure_time_warp(
-    balls: usize,
-    until: f64,
-    pure: bool,
-    workers: &[usize],
-) -> Result<Vec<TwRow>, BenchError> {
-    crate::memory::transparent_huge_pages(false);
-    let rows = time_warp_rows(balls, until, pure, workers);
-    crate::memory::transparent_huge_pages(true);
-    rows
-}
-
-fn time_warp_rows(
     balls: usize,
     until: f64,
     pure: bool,

@@ -4,7 +4,7 @@
 use crate::common::{usage, Failure};
 use pdes_kernel::phold::{PholdReport, ROSS_EVENTS_PER_SECOND_PER_CORE};
 use poolsim::bench::{
-    self, BenchOptions, Measured, ObjectsRow, TwRow, SECTORED_WARM_UP, SECTORED_WINDOW,
+    self, BenchOptions, Measured, ObjectsRow, Part, TwRow, SECTORED_WARM_UP, SECTORED_WINDOW,
 };
 
 /// Arguments of `poolsim bench`.
@@ -96,6 +96,10 @@ impl BenchArgs {
 pub fn bench(a: &BenchArgs) -> Result<(), Failure> {
     let mut table = Table::new(a);
     let report = bench::run(&a.options(), &mut |m| {
+        // Time Warp runs without transparent huge pages, as `poolsim run` runs it
+        if let Measured::Starting(part) = m {
+            poolsim::memory::transparent_huge_pages(part != Part::TimeWarp);
+        }
         if !a.json {
             table.print(m);
         }
@@ -174,6 +178,7 @@ impl<'a> Table<'a> {
 
     fn print(&mut self, m: Measured) {
         match m {
+            Measured::Starting(_) => {}
             Measured::Row(r) => {
                 self.head("rows");
                 println!(
