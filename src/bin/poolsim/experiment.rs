@@ -76,5 +76,14 @@ pub fn experiment(a: &ExperimentArgs) -> Result<(), Failure> {
         Progress::RunDone => bar.inc(1),
         Progress::Finished => bar.finish_and_clear(),
     };
-    experiment::run(&a.options(), &mut progress).map_err(|e| usage(e.to_string()))
+    experiment::run(&a.options(), &mut progress).map_err(|e| usage(e.to_string()))?;
+    let report = match a.which {
+        WhichArg::Thesis => "report.md",
+        WhichArg::Reversal => "reversal.md",
+    };
+    println!(
+        "wrote {} (with its tables, figures and data beside it)",
+        a.out.join(report).display()
+    );
+    Ok(())
 }

@@ -135,21 +135,7 @@ pub fn demo(json: bool, out: &std::path::Path) -> Result<(), Failure> {
         return Ok(());
     }
     print!("{}", human_summary(&rec.summary));
-    {
-        let m = &rec.summary.messages;
-        println!(
-            "messages      {} (thesis table 5 total: NewVelocity {}, Collision {}, Cancel {}, \
-             VelocityChange {}, SectorEntry {}, SectorDeparture {})",
-            m.total,
-            m.NewVelocity,
-            m.Collision,
-            m.Cancel,
-            m.VelocityChange,
-            m.SectorEntry,
-            m.SectorDeparture
-        );
-        println!("sectors       2 x 2 (thesis plates 9-13)");
-        println!("page          {line}");
-    }
+    println!("sectors       2 x 2 (thesis plates 9-13)");
+    println!("page          {line}");
     Ok(())
 }

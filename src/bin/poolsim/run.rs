@@ -440,6 +440,20 @@ pub fn human_summary(s: &RunSummary) -> String {
             s.wall_seconds, s.setup_seconds, s.events_per_second
         ),
     ];
+    if !matches!(s.engine.as_str(), "event-list" | "time-step") {
+        let m = &s.messages;
+        lines.push(format!(
+            "messages      {} (thesis table 5 total: NewVelocity {}, Collision {}, Cancel {}, \
+             VelocityChange {}, SectorEntry {}, SectorDeparture {})",
+            m.total,
+            m.NewVelocity,
+            m.Collision,
+            m.Cancel,
+            m.VelocityChange,
+            m.SectorEntry,
+            m.SectorDeparture
+        ));
+    }
     if let Some(tw) = &s.time_warp {
         let st = &tw.stats;
         let count = |n: u64, one: &str| match n {
