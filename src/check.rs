@@ -11,6 +11,17 @@ use crate::physics::kinetic_energy;
 /// Largest overlap allowed between two balls, or a ball and a cushion, as a fraction of a radius.
 pub const OVERLAP_TOLERANCE: f64 = 1e-9;
 
+/// Positions are known to within a few units in the last place of their coordinates: an overlap
+/// below this many machine epsilons of the largest coordinate is rounding, whatever the radius
+/// (a ball of radius 10^-6 at x = 400 is placed to 6 × 10^-14, 6 × 10^-8 of its radius).
+const POSITION_ULPS: f64 = 16.0;
+
+/// The overlap allowed for a ball of radius `r` at `p`: a fraction of the radius, or the
+/// resolution of the position where that is coarser.
+fn slack(r: f64, p: crate::geometry::Vec2) -> f64 {
+    (OVERLAP_TOLERANCE * r).max(POSITION_ULPS * f64::EPSILON * p.x.abs().max(p.y.abs()))
+}
+
 /// Largest relative drift of kinetic energy allowed on an elastic table.
 pub const ENERGY_TOLERANCE: f64 = 1e-9;
 
@@ -63,7 +74,7 @@ impl Checker {
                 return;
             }
             let overlap = bi.radius + bj.radius - (bj.traj.at(t) - p).norm();
-            if overlap > OVERLAP_TOLERANCE * bi.radius.min(bj.radius) {
+            if overlap > slack(bi.radius.min(bj.radius), p) {
                 let (a, b) = (i.min(j), i.max(j));
                 err = Some(format!(
                     "t = {t}: Ball-{} and Ball-{} overlap by {overlap:e} ({:e} of a radius)",
@@ -76,7 +87,7 @@ impl Checker {
         if let Some(e) = err {
             return Err(RunError::Violation(e));
         }
-        let slack = OVERLAP_TOLERANCE * bi.radius;
+        let slack = slack(bi.radius, p);
         let open_plane = table.cushions.is_empty() && table.pockets.is_empty();
         if !open_plane
             && (p.x < table.lo.x - slack

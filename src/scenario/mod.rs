@@ -391,16 +391,19 @@ impl Scenario {
         closed.then_some(edges)
     }
 
-    /// On a closed table every cushion and pocket mouth must have the table on its right: the
-    /// point just to the right of its middle lies inside the loops. One wound the wrong way
-    /// would be met from behind, and a ball would pass through it.
-    fn check_each_winding(&self, loops: &[(Vec2, Vec2)]) -> Result<(), Invalid> {
+    /// Every cushion and pocket mouth must have the table on its right. The point just to the
+    /// right of its middle must lie inside the table's box (where the box has an area), and, on
+    /// a closed table, inside the loops its sides make. One wound the wrong way would be met
+    /// from behind, and a ball would pass through it.
+    fn check_each_winding(&self, loops: Option<&[(Vec2, Vec2)]>) -> Result<(), Invalid> {
         let (lo, hi) = self.bounds();
         let step = 1e-7 * (hi - lo).norm();
-        let wrong = loops.iter().position(|&(a, b)| {
+        let boxed = lo.x < hi.x && lo.y < hi.y;
+        let wrong = self.edges().iter().position(|&(a, b)| {
             let along = b - a;
             let right = (1.0 / along.norm()) * along.perp_cw();
-            !encloses(loops, 0.5 * (a + b) + step * right)
+            let p = 0.5 * (a + b) + step * right;
+            (boxed && !inside_box(p, lo, hi)) || loops.is_some_and(|e| !encloses(e, p))
         });
         let Some(k) = wrong else {
             return Ok(());
@@ -425,9 +428,7 @@ impl Scenario {
         self.check_winding()?;
         let (lo, hi) = self.bounds();
         let loops = self.closed_edges();
-        if let Some(loops) = &loops {
-            self.check_each_winding(loops)?;
-        }
+        self.check_each_winding(loops.as_deref())?;
         for (i, b) in self.balls.iter().enumerate() {
             let p = b.position;
             let field = || format!("ball[{}].position", i + 1);
