@@ -231,8 +231,7 @@ impl EventList {
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let cell = grid.cell_at(b.traj.position);
-                grid.insert(i as u32, cell);
+                let cell = grid.insert_at(i as u32, b.traj.position);
                 Slot {
                     traj: b.traj,
                     radius: b.radius,
@@ -575,10 +574,9 @@ impl EventList {
     #[inline]
     fn come_back(&mut self, i: u32, key: &Key) -> EventKind {
         let b = &mut self.slots[i as usize];
-        let cell = self.grid.cell_at(b.traj.position);
+        let cell = self.grid.insert_at(i, b.traj.position);
         b.cell = cell;
         b.counter = b.counter.wrapping_add(1);
-        self.grid.insert(i, cell);
         self.pocket[i as usize] = None;
         self.own[i as usize].fixed_at = key.clone();
         self.predict(i);
