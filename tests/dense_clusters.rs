@@ -77,6 +77,29 @@ fn specks(n: u32) -> Scenario {
     scenario("specks", &centres, 1e-6, 1e-5, (2.54, 1.27))
 }
 
+/// One ball of radius 5 and 300 of radius 0.01 packed 0.05 apart beside it, on a `side` ×
+/// `side` table: the cells, sized for the big ball, each hold far more of the small ones than
+/// their slots.
+fn grains_and_a_boulder(side: f64) -> Scenario {
+    let centres: Vec<Vec2> = (0..300)
+        .map(|k| {
+            Vec2::new(
+                20.0 + 0.05 * f64::from(k / 20),
+                20.0 + 0.05 * f64::from(k % 20),
+            )
+        })
+        .collect();
+    let mut s = scenario("grains-and-a-boulder", &centres, 0.01, 0.3, (side, side));
+    s.balls.push(BallSpec {
+        position: Vec2::new(10.0, 12.0),
+        velocity: Vec2::new(3.0, 2.0),
+        radius: 5.0,
+        mass: 1.0,
+    });
+    s.until = 3.0;
+    s
+}
+
 fn run(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>, String) {
     let mut rec = TraceRecorder::default();
     let cfg = RunConfig {
@@ -162,4 +185,17 @@ fn an_exploding_rack_recycles_its_cells_and_stays_exact() {
         delay: NvDelay::Exact,
     };
     assert_eq!(run(&s, objects, false).1, digest);
+}
+
+#[test]
+fn balls_of_very_different_sizes_crowd_a_cell_on_any_table() {
+    for side in [100.0, 4000.0] {
+        let s = grains_and_a_boulder(side);
+        let (_, digest) = run(&s, EngineKind::EventList, true);
+        let objects = EngineKind::Objects {
+            delay: NvDelay::Exact,
+        };
+        assert_eq!(run(&s, objects, false).1, digest, "on a {side} table");
+        run(&s, EngineKind::TimeStep { dt: 0.001 }, false);
+    }
 }

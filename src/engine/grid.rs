@@ -52,8 +52,15 @@ const MAX_SLOTS: usize = 16;
 /// The most cells along a side, so that cell coordinates and their neighbours' fit in a `u32`.
 const MAX_SIDE: f64 = (1u32 << 30) as f64;
 
+/// The steps to the four cells that share an edge with a cell.
+const STEPS: [(i64, i64); 4] = [(1, 0), (-1, 0), (0, 1), (0, -1)];
+
+/// For each of [`STEPS`], the neighbours (places in [`AROUND`]) of the cell stepped into that are
+/// not next to the cell stepped from.
+const ENTERING: [[usize; 3]; 4] = [[2, 4, 7], [0, 3, 5], [5, 6, 7], [0, 1, 2]];
+
 /// The eight neighbours of a cell as coordinate offsets; entry `7 - k` is the opposite of `k`.
-const AROUND: [(i64, i64); 8] = [
+const AROUND: [(i32, i32); 8] = [
     (-1, -1),
     (0, -1),
     (1, -1),
@@ -456,8 +463,8 @@ impl Grid {
             None if c < self.nx * self.ny => {
                 let (cx, cy) = (i64::from(c % self.nx), i64::from(c / self.nx));
                 out[0] = c;
-                for (k, (dx, dy)) in AROUND.iter().enumerate() {
-                    let (x, y) = (cx + dx, cy + dy);
+                for (k, &(dx, dy)) in AROUND.iter().enumerate() {
+                    let (x, y) = (cx + i64::from(dx), cy + i64::from(dy));
                     if (0..i64::from(self.nx)).contains(&x) && (0..i64::from(self.ny)).contains(&y)
                     {
                         out[k + 1] = (y * i64::from(self.nx) + x) as u32;
@@ -470,6 +477,7 @@ impl Grid {
     }
 
     /// Calls `f` with every ball of cell `c`: its slots, then its spill list.
+    #[inline(always)]
     fn for_each_in(&self, c: u32, f: &mut impl FnMut(u32)) {
         let c = c as usize;
         for &j in &self.slots[c * self.cap..(c + 1) * self.cap] {
@@ -477,17 +485,31 @@ impl Grid {
                 f(j);
             }
         }
-        if let Some(list) = self.spill.get(&(c as u32)) {
-            list.iter().for_each(|&j| f(j));
+        if !self.spill.is_empty() {
+            if let Some(list) = self.spill.get(&(c as u32)) {
+                list.iter().for_each(|&j| f(j));
+            }
         }
     }
 
     /// [`Grid::prefetch_near`] through the cell ids.
     #[inline(never)]
     fn prefetch_block(&self, c: u32) {
-        for k in self.block(c) {
-            if k != NIL {
-                prefetch(&self.slots[k as usize * self.cap]);
+        let Some(h) = &self.hashed else {
+            for k in self.block(c) {
+                if k != NIL {
+                    prefetch(&self.slots[k as usize * self.cap]);
+                }
+            }
+            return;
+        };
+        if let Some(around) = h.around.get(c as usize) {
+            prefetch(&self.slots[c as usize * self.cap]);
+            // a missing neighbour (`NIL`) is past the end
+            for &k in around {
+                if let Some(slot) = self.slots.get(k as usize * self.cap) {
+                    prefetch(slot);
+                }
             }
         }
     }
@@ -495,7 +517,16 @@ impl Grid {
     /// [`Grid::for_each_near`] through the cell ids.
     #[inline(never)]
     fn for_each_in_block(&self, c: u32, f: &mut impl FnMut(u32)) {
-        for k in self.block(c) {
+        let Some(h) = &self.hashed else {
+            for k in self.block(c) {
+                if k != NIL {
+                    self.for_each_in(k, f);
+                }
+            }
+            return;
+        };
+        self.for_each_in(c, f);
+        for &k in &h.around[c as usize] {
             if k != NIL {
                 self.for_each_in(k, f);
             }
@@ -506,13 +537,25 @@ impl Grid {
     #[inline(never)]
     fn for_each_entering_block(&self, from: u32, to: u32, f: &mut impl FnMut(u32)) {
         let (fx, fy) = self.coords(from);
-        for k in self.block(to) {
-            if k == NIL {
-                continue;
+        let (tx, ty) = self.coords(to);
+        let step = (i64::from(tx) - i64::from(fx), i64::from(ty) - i64::from(fy));
+        if let (Some(h), Some(k)) = (&self.hashed, STEPS.iter().position(|&d| d == step)) {
+            // a crossing into a cell next to it: the three cells on its far side
+            for e in ENTERING[k] {
+                let n = h.around[to as usize][e];
+                if n != NIL {
+                    self.for_each_in(n, f);
+                }
             }
-            let (x, y) = self.coords(k);
-            if x.abs_diff(fx) > 1 || y.abs_diff(fy) > 1 {
-                self.for_each_in(k, f);
+            return;
+        }
+        let (fx, fy) = (i64::from(fx), i64::from(fy));
+        let block = self.block(to);
+        let (tx, ty) = (i64::from(tx), i64::from(ty));
+        for (&n, (dx, dy)) in block.iter().zip([(0, 0)].into_iter().chain(AROUND)) {
+            let (x, y) = (tx + i64::from(dx), ty + i64::from(dy));
+            if n != NIL && ((x - fx).abs() > 1 || (y - fy).abs() > 1) {
+                self.for_each_in(n, f);
             }
         }
     }
@@ -570,31 +613,36 @@ impl Grid {
         t0: f64,
     ) -> Option<(f64, u32)> {
         let (cx, cy) = self.coords(c);
-        let mut best: Option<(f64, (u32, u32))> = None;
+        // the time, and the neighbour entered as its place in `AROUND`
+        let mut best: Option<(f64, usize)> = None;
         if velocity.x > 0.0 && cx + 1 < self.nx {
             let b = self.lo.x + f64::from(cx + 1) * self.width;
-            best = Some((t0 + (b - position.x) / velocity.x, (cx + 1, cy)));
+            best = Some((t0 + (b - position.x) / velocity.x, 4));
         } else if velocity.x < 0.0 && cx > 0 {
             let b = self.lo.x + f64::from(cx) * self.width;
-            best = Some((t0 + (b - position.x) / velocity.x, (cx - 1, cy)));
+            best = Some((t0 + (b - position.x) / velocity.x, 3));
         }
         let y = if velocity.y > 0.0 && cy + 1 < self.ny {
             let b = self.lo.y + f64::from(cy + 1) * self.height;
-            Some((t0 + (b - position.y) / velocity.y, (cx, cy + 1)))
+            Some((t0 + (b - position.y) / velocity.y, 6))
         } else if velocity.y < 0.0 && cy > 0 {
             let b = self.lo.y + f64::from(cy) * self.height;
-            Some((t0 + (b - position.y) / velocity.y, (cx, cy - 1)))
+            Some((t0 + (b - position.y) / velocity.y, 1))
         } else {
             None
         };
-        let exit = match (best, y) {
+        let (t, k) = match (best, y) {
             (Some(a), Some(b)) => Some(if b.0 < a.0 { b } else { a }),
             (a, b) => a.or(b),
+        }?;
+        let (dx, dy) = AROUND[k];
+        let (x, y) = (cx.wrapping_add_signed(dx), cy.wrapping_add_signed(dy));
+        let to = match &self.hashed {
+            None => y * self.nx + x,
+            Some(h) if h.around[c as usize][k] != NIL => h.around[c as usize][k],
+            Some(_) => self.cell_in_use(x, y),
         };
-        if self.hashed.is_none() {
-            return exit.map(|(t, (x, y))| (t, y * self.nx + x));
-        }
-        exit.map(|(t, (x, y))| (t, self.cell_in_use(x, y)))
+        Some((t, to))
     }
 
     /// The id of the cell at coordinates `(x, y)` in the hashed layout, brought into use if it
@@ -622,8 +670,8 @@ impl Grid {
         };
         h.ids.insert(key, c);
         h.at[c as usize] = (x, y);
-        for (k, (dx, dy)) in AROUND.iter().enumerate() {
-            let (ax, ay) = (i64::from(x) + dx, i64::from(y) + dy);
+        for (k, &(dx, dy)) in AROUND.iter().enumerate() {
+            let (ax, ay) = (i64::from(x) + i64::from(dx), i64::from(y) + i64::from(dy));
             if ax < 0 || ay < 0 {
                 continue;
             }
