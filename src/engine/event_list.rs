@@ -226,7 +226,13 @@ impl EventList {
         let balls = BallState::initial(s, start);
         let n = balls.len();
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let mut grid = Grid::new(&table, n, rmax, 2.0 * rmax * opts.cell_diameters.max(1.0));
+        let centres: Vec<_> = balls.iter().map(|b| b.traj.position).collect();
+        let mut grid = Grid::new(
+            &table,
+            &centres,
+            rmax,
+            2.0 * rmax * opts.cell_diameters.max(1.0),
+        );
         let slots = balls
             .iter()
             .enumerate()

@@ -11,10 +11,11 @@
 //!
 //! * **Dense**, when the table holds at most about `4 N` such cells: an array of every cell in
 //!   row order, so the 3 × 3 block around a cell is three short runs of memory and its
-//!   neighbours are found by arithmetic on the id. With few balls (at most [`FEW_BALLS`]) it is
-//!   used on any table, its cells widened until there are about `4 N` of them: no cell can then
-//!   hold many balls, and wide cells mean fewer crossings.
-//! * **Hashed**, otherwise: only the cells near a ball exist, under compact ids from a hash of
+//!   neighbours are found by arithmetic on the id. On a larger table its cells are widened until
+//!   there are about `4 N` of them, which means fewer crossings, if there are few balls (at most
+//!   [`FEW_BALLS`]: no cell can hold many) or if no more than [`CROWDED`] start in any one cell
+//!   (a dilute gas; a cluster that forms later costs more pair tests but works).
+//! * **Hashed**, for a cluster on a large table: only the cells near a ball exist, under compact ids from a hash of
 //!   their coordinates; each keeps the ids of its existing neighbours. A cell comes into use when
 //!   a ball is put in it or its next crossing enters it (always a cell next to the ball's), and
 //!   once about `12 N` are in use a sweep recycles those with no ball in their 3 × 3 block.
@@ -45,6 +46,9 @@ const CELL_MARGIN: f64 = 1.0 + 1e-6;
 /// With at most this many balls the layout is dense on any table: no cell can hold more of them,
 /// and wider cells mean fewer crossings.
 pub const FEW_BALLS: usize = 64;
+
+/// A grid widened to fit the table is used only if at most this many balls start in each cell.
+pub const CROWDED: usize = 8;
 
 /// The most slots a cell holds inline; further balls go to its spill list.
 const MAX_SLOTS: usize = 16;
@@ -119,21 +123,30 @@ struct Hashed {
 }
 
 impl Grid {
-    /// Builds a grid for `table` with balls of radius at most `rmax`, `n` balls and the given
-    /// minimum cell width (at least a diameter; larger means fewer crossings, more pair tests).
-    /// The layout is dense if the table holds at most about `4 n` cells or there are few balls
-    /// (their cells are then widened to fit that count), hashed otherwise.
-    pub fn new(table: &Table, n: usize, rmax: f64, min_cell: f64) -> Grid {
+    /// Builds a grid for `table` with balls of radius at most `rmax` whose centres start at
+    /// `centres`, and the given minimum cell width (at least a diameter; larger means fewer
+    /// crossings, more pair tests). The layout is dense if the table holds at most about `4 n`
+    /// such cells; otherwise its cells are widened until there are about `4 n` of them, unless
+    /// more than a few balls would start in one of those ([`CROWDED`]; then the layout is hashed,
+    /// its cells unwidened).
+    pub fn new(table: &Table, centres: &[Vec2], rmax: f64, min_cell: f64) -> Grid {
+        let n = centres.len();
         let span = table.hi - table.lo;
         let w_min = (2.0 * rmax * CELL_MARGIN).max(min_cell);
         let most = (4 * n).max(16) as f64;
-        let mut nx = (span.x / w_min).floor().clamp(1.0, MAX_SIDE);
-        let mut ny = (span.y / w_min).floor().clamp(1.0, MAX_SIDE);
-        let hashed = nx * ny > most && n > FEW_BALLS;
-        while !hashed && nx * ny > most {
+        let fine = (
+            (span.x / w_min).floor().clamp(1.0, MAX_SIDE),
+            (span.y / w_min).floor().clamp(1.0, MAX_SIDE),
+        );
+        let (mut nx, mut ny) = fine;
+        while nx * ny > most {
             nx = (nx / 2.0).floor().max(1.0);
             ny = (ny / 2.0).floor().max(1.0);
         }
+        let hashed = fine.0 * fine.1 > most
+            && n > FEW_BALLS
+            && crowded(table, centres, (nx as u32, ny as u32));
+        let (nx, ny) = if hashed { fine } else { (nx, ny) };
         let (nx, ny) = (nx as u32, ny as u32);
         let cells = if hashed { 0 } else { (nx * ny) as usize };
         let mut g = Grid {
@@ -736,6 +749,25 @@ impl Grid {
     }
 }
 
+/// Whether more than [`CROWDED`] of `centres` fall in one cell of an `nx` × `ny` grid over
+/// `table`.
+fn crowded(table: &Table, centres: &[Vec2], (nx, ny): (u32, u32)) -> bool {
+    let span = table.hi - table.lo;
+    let (w, h) = (span.x / f64::from(nx), span.y / f64::from(ny));
+    let mut count = vec![0usize; (nx * ny) as usize];
+    centres.iter().any(|p| {
+        let cx = ((p.x - table.lo.x) / w)
+            .floor()
+            .clamp(0.0, f64::from(nx - 1)) as u32;
+        let cy = ((p.y - table.lo.y) / h)
+            .floor()
+            .clamp(0.0, f64::from(ny - 1)) as u32;
+        let k = &mut count[(cy * nx + cx) as usize];
+        *k += 1;
+        *k > CROWDED
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -781,7 +813,7 @@ mod tests {
     fn any_number_of_centres_share_a_cell() {
         let n = 300;
         for (side, hashed) in [(10.0, false), (4000.0, true)] {
-            let mut g = Grid::new(&table(n, side), n, 1.0, 2.0);
+            let mut g = Grid::new(&table(n, side), &vec![Vec2::new(5.0, 5.0); n], 1.0, 2.0);
             assert_eq!(g.is_hashed(), hashed);
             let cells: Vec<u32> = (0..n as u32)
                 .map(|i| g.insert_at(i, Vec2::new(5.0, 5.0)))
@@ -805,7 +837,7 @@ mod tests {
     #[test]
     fn hashed_cells_are_recycled() {
         let n = 100;
-        let mut g = Grid::new(&table(n, 4000.0), n, 1.0, 2.0);
+        let mut g = Grid::new(&table(n, 4000.0), &vec![Vec2::new(5.0, 5.0); n], 1.0, 2.0);
         assert!(g.is_hashed());
         let mut c = g.insert_at(0, Vec2::new(1.0, 1.0));
         let (mut p, v) = (Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.7));

@@ -66,7 +66,8 @@ impl TimeStep {
         let table = Table::new(s);
         let balls = BallState::initial(s, opts.span.start);
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let mut grid = Grid::new(&table, balls.len(), rmax, 2.0 * rmax);
+        let centres: Vec<_> = balls.iter().map(|b| b.traj.position).collect();
+        let mut grid = Grid::new(&table, &centres, rmax, 2.0 * rmax);
         for (i, b) in balls.iter().enumerate() {
             grid.insert_at(i as u32, b.traj.position);
         }
