@@ -226,13 +226,18 @@ impl EventList {
         let balls = BallState::initial(s, start);
         let n = balls.len();
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let mut grid = Grid::new(&table, n, rmax, 2.0 * rmax * opts.cell_diameters.max(1.0));
+        let centres: Vec<_> = balls.iter().map(|b| b.traj.position).collect();
+        let mut grid = Grid::new(
+            &table,
+            &centres,
+            rmax,
+            2.0 * rmax * opts.cell_diameters.max(1.0),
+        );
         let slots = balls
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let cell = grid.cell_at(b.traj.position);
-                grid.insert(i as u32, cell);
+                let cell = grid.insert_at(i as u32, b.traj.position);
                 Slot {
                     traj: b.traj,
                     radius: b.radius,
@@ -575,10 +580,9 @@ impl EventList {
     #[inline]
     fn come_back(&mut self, i: u32, key: &Key) -> EventKind {
         let b = &mut self.slots[i as usize];
-        let cell = self.grid.cell_at(b.traj.position);
+        let cell = self.grid.insert_at(i, b.traj.position);
         b.cell = cell;
         b.counter = b.counter.wrapping_add(1);
-        self.grid.insert(i, cell);
         self.pocket[i as usize] = None;
         self.own[i as usize].fixed_at = key.clone();
         self.predict(i);

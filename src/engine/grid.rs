@@ -3,15 +3,38 @@
 //! Cells are at least a ball diameter wide (with a small margin), and a ball belongs to the cell
 //! holding its centre, so any two touching balls sit in the same or adjacent cells. The outermost
 //! cells reach out to infinity: a ball that leaves the table's box stays in its edge cell and the
-//! neighbourhood rule still holds. Each cell stores its balls' indices inline in a fixed number of
-//! slots, so the 3 × 3 block around a ball is read from three short runs of memory and the balls'
-//! own records can then be fetched in parallel (a linked list would chain one cache miss after
-//! another); when a cell fills up, every cell gets twice the slots. Fixed objects are listed once
-//! per cell they may reach, in compressed rows.
+//! neighbourhood rule still holds.
+//!
+//! Cells are as narrow as that rule allows wherever the balls are, so that a dense cluster costs
+//! no more per event than the same balls spread out, and memory stays linear in the ball count
+//! `N` on any table. Two layouts share one set of cell ids:
+//!
+//! * **Dense**, when the table holds at most about `4 N` such cells: an array of every cell in
+//!   row order, so the 3 × 3 block around a cell is three short runs of memory and its
+//!   neighbours are found by arithmetic on the id. On a larger table its cells are widened until
+//!   there are about `4 N` of them, which means fewer crossings, if there are few balls (at most
+//!   [`FEW_BALLS`]: no cell can hold many) or if no more than [`CROWDED`] start in any one cell
+//!   (a dilute gas; a cluster that forms later costs more pair tests but works).
+//! * **Hashed**, for a cluster on a large table: only the cells near a ball exist, under compact ids from a hash of
+//!   their coordinates; each keeps the ids of its existing neighbours. A cell comes into use when
+//!   a ball is put in it or its next crossing enters it (always a cell next to the ball's), and
+//!   once about `12 N` are in use a sweep recycles those with no ball in their 3 × 3 block.
+//!   Fixed objects are listed per square block of cells, about `4 N` blocks in all, and a cell
+//!   takes its block's list.
+//!
+//! Each cell stores its balls' indices inline in a fixed number of slots, so a block's balls are
+//! read from a few short runs of memory and the balls' own records can then be fetched in
+//! parallel (a linked list would chain one cache miss after another); when a cell fills up,
+//! every cell gets twice the slots, up to sixteen. Beyond that (balls of very different
+//! sizes crowding one cell) the extra balls go to the cell's spill list. The fast paths serve the
+//! dense layout with nothing spilled; the hashed layout and spilled balls take a general path
+//! through the cell coordinates. Fixed objects are listed once per dense cell or hashed block
+//! they may reach.
 
 use super::Table;
 use crate::geometry::Vec2;
 use pdes_kernel::prefetch::prefetch;
+use rustc_hash::FxHashMap;
 
 const NIL: u32 = u32::MAX;
 
@@ -19,6 +42,38 @@ const NIL: u32 = u32::MAX;
 /// balls that become neighbours when one of them crosses a cell boundary are strictly apart, so a
 /// crossing never uncovers an immediate collision.
 const CELL_MARGIN: f64 = 1.0 + 1e-6;
+
+/// With at most this many balls the layout is dense on any table: no cell can hold more of them,
+/// and wider cells mean fewer crossings.
+pub const FEW_BALLS: usize = 64;
+
+/// A grid widened to fit the table is used only if at most this many balls start in each cell.
+pub const CROWDED: usize = 8;
+
+/// The most slots a cell holds inline; further balls go to its spill list.
+const MAX_SLOTS: usize = 16;
+
+/// The most cells along a side, so that cell coordinates and their neighbours' fit in a `u32`.
+const MAX_SIDE: f64 = (1u32 << 30) as f64;
+
+/// The steps to the four cells that share an edge with a cell.
+const STEPS: [(i64, i64); 4] = [(1, 0), (-1, 0), (0, 1), (0, -1)];
+
+/// For each of [`STEPS`], the neighbours (places in [`AROUND`]) of the cell stepped into that are
+/// not next to the cell stepped from.
+const ENTERING: [[usize; 3]; 4] = [[2, 4, 7], [0, 3, 5], [5, 6, 7], [0, 1, 2]];
+
+/// The eight neighbours of a cell as coordinate offsets; entry `7 - k` is the opposite of `k`.
+const AROUND: [(i32, i32); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
 
 /// The cell grid: geometry, per-cell ball lists and per-cell fixed-object lists.
 #[derive(Clone, Debug)]
@@ -32,28 +87,68 @@ pub struct Grid {
     /// `cap` ball indices per cell, the balls first and `NIL` after them.
     slots: Vec<u32>,
     cell_of: Vec<u32>,
-    fixed_start: Vec<u32>,
+    /// Each cell's fixed objects: a range of `fixed_items`.
+    fixed_span: Vec<(u32, u32)>,
     fixed_items: Vec<u32>,
     /// One bit per cell: set where some fixed object is near. Small enough to stay in cache, so
     /// the many cells with none cost no trip to memory.
     has_fixed: Vec<u64>,
+    /// Set when the fast paths do not apply: the layout is hashed, or some ball is spilled.
+    general: bool,
+    /// The hashed layout's cells; `None` for the dense layout.
+    hashed: Option<Box<Hashed>>,
+    /// The balls beyond a full cell's slots, by cell.
+    spill: FxHashMap<u32, Vec<u32>>,
+}
+
+/// The cells of the hashed layout: those in use, under compact ids.
+#[derive(Clone, Debug)]
+struct Hashed {
+    /// Cell coordinates (`y << 32 | x`) to id.
+    ids: FxHashMap<u64, u32>,
+    /// Each id's coordinates; `(NIL, NIL)` for a free id.
+    at: Vec<(u32, u32)>,
+    /// Each id's neighbours in [`AROUND`] order (`NIL` where none exists).
+    around: Vec<[u32; 8]>,
+    /// Free ids.
+    free: Vec<u32>,
+    /// Ids in use before a sweep recycles idle ones.
+    limit: usize,
+    /// Cells along a side of a block.
+    side: u32,
+    /// Blocks along x.
+    blocks_x: u32,
+    /// Each block's fixed objects: a range of the grid's `fixed_items`.
+    block_fixed: Vec<(u32, u32)>,
 }
 
 impl Grid {
-    /// Builds a grid for `table` with balls of radius at most `rmax`, `n` balls and the given
-    /// minimum cell width (at least a diameter; larger means fewer crossings, more pair tests).
-    /// The number of cells is capped near `4 n` so that memory stays linear in the ball count.
-    pub fn new(table: &Table, n: usize, rmax: f64, min_cell: f64) -> Grid {
+    /// Builds a grid for `table` with balls of radius at most `rmax` whose centres start at
+    /// `centres`, and the given minimum cell width (at least a diameter; larger means fewer
+    /// crossings, more pair tests). The layout is dense if the table holds at most about `4 n`
+    /// such cells; otherwise its cells are widened until there are about `4 n` of them, unless
+    /// more than a few balls would start in one of those ([`CROWDED`]; then the layout is hashed,
+    /// its cells unwidened).
+    pub fn new(table: &Table, centres: &[Vec2], rmax: f64, min_cell: f64) -> Grid {
+        let n = centres.len();
         let span = table.hi - table.lo;
         let w_min = (2.0 * rmax * CELL_MARGIN).max(min_cell);
-        let cap = (4 * n).max(16) as f64;
-        let mut nx = (span.x / w_min).floor().clamp(1.0, 1e6);
-        let mut ny = (span.y / w_min).floor().clamp(1.0, 1e6);
-        while nx * ny > cap {
+        let most = (4 * n).max(16) as f64;
+        let fine = (
+            (span.x / w_min).floor().clamp(1.0, MAX_SIDE),
+            (span.y / w_min).floor().clamp(1.0, MAX_SIDE),
+        );
+        let (mut nx, mut ny) = fine;
+        while nx * ny > most {
             nx = (nx / 2.0).floor().max(1.0);
             ny = (ny / 2.0).floor().max(1.0);
         }
+        let hashed = fine.0 * fine.1 > most
+            && n > FEW_BALLS
+            && crowded(table, centres, (nx as u32, ny as u32));
+        let (nx, ny) = if hashed { fine } else { (nx, ny) };
         let (nx, ny) = (nx as u32, ny as u32);
+        let cells = if hashed { 0 } else { (nx * ny) as usize };
         let mut g = Grid {
             lo: table.lo,
             width: span.x / f64::from(nx),
@@ -61,40 +156,77 @@ impl Grid {
             nx,
             ny,
             cap: 4,
-            slots: vec![NIL; 4 * (nx * ny) as usize],
+            slots: vec![NIL; 4 * cells],
             cell_of: vec![NIL; n],
-            fixed_start: Vec::new(),
+            fixed_span: Vec::with_capacity(cells),
             fixed_items: Vec::new(),
-            has_fixed: vec![0; (nx * ny).div_ceil(64) as usize],
+            has_fixed: vec![0; cells.div_ceil(64)],
+            general: hashed,
+            hashed: None,
+            spill: FxHashMap::default(),
         };
         if g.width.is_nan() || g.width <= 0.0 || g.height.is_nan() || g.height <= 0.0 {
             g.width = w_min;
             g.height = w_min;
         }
-        g.index_fixed(table, rmax);
+        let reach2 = (rmax * 1.01 + 1e-9 * (g.width + g.height)).powi(2);
+        if hashed {
+            g.hashed = Some(Box::new(g.blocks(table, reach2, most)));
+        } else {
+            for c in 0..nx * ny {
+                let span = g.list_fixed(table, reach2, g.cell_rect((c % nx, c / nx)));
+                g.fixed_span.push(span);
+                if span.1 > span.0 {
+                    g.has_fixed[c as usize / 64] |= 1 << (c % 64);
+                }
+            }
+        }
         g
     }
 
-    fn index_fixed(&mut self, table: &Table, rmax: f64) {
-        let reach2 = (rmax * 1.01 + 1e-9 * (self.width + self.height)).powi(2);
-        let first = table.n_balls;
-        let ids: Vec<u32> = (first..first + table.n_fixed()).collect();
-        self.fixed_start.push(0);
-        for c in 0..self.nx * self.ny {
-            let (lo, hi) = self.cell_rect(c);
-            for &id in &ids {
-                if table.distance2_to_rect(id, lo, hi) <= reach2 {
-                    self.fixed_items.push(id);
-                    self.has_fixed[c as usize / 64] |= 1 << (c % 64);
-                }
-            }
-            self.fixed_start.push(self.fixed_items.len() as u32);
+    /// The hashed layout, with no cell in use yet and the fixed objects listed per square block
+    /// of cells, the blocks as few as about `most`.
+    fn blocks(&mut self, table: &Table, reach2: f64, most: f64) -> Hashed {
+        let mut side = 1;
+        while f64::from(self.nx.div_ceil(side)) * f64::from(self.ny.div_ceil(side)) > most {
+            side *= 2;
+        }
+        let (bx, by) = (self.nx.div_ceil(side), self.ny.div_ceil(side));
+        let mut block_fixed = Vec::with_capacity((bx * by) as usize);
+        for b in 0..bx * by {
+            let (x, y) = ((b % bx) * side, (b / bx) * side);
+            let last = ((x + side).min(self.nx) - 1, (y + side).min(self.ny) - 1);
+            let (lo, hi) = (self.cell_rect((x, y)).0, self.cell_rect(last).1);
+            block_fixed.push(self.list_fixed(table, reach2, (lo, hi)));
+        }
+        Hashed {
+            ids: FxHashMap::default(),
+            at: Vec::new(),
+            around: Vec::new(),
+            free: Vec::new(),
+            limit: 3 * most as usize + 64,
+            side,
+            blocks_x: bx,
+            block_fixed,
         }
     }
 
-    /// The rectangle of cell `c`, with outer cells extended to infinity.
-    fn cell_rect(&self, c: u32) -> (Vec2, Vec2) {
-        let (cx, cy) = (c % self.nx, c / self.nx);
+    /// Lists the fixed objects within `reach2` (squared) of the rectangle from `lo` to `hi`, and
+    /// returns their range of `fixed_items`.
+    fn list_fixed(&mut self, table: &Table, reach2: f64, (lo, hi): (Vec2, Vec2)) -> (u32, u32) {
+        let start = self.fixed_items.len() as u32;
+        let first = table.n_balls;
+        for id in first..first + table.n_fixed() {
+            if table.distance2_to_rect(id, lo, hi) <= reach2 {
+                self.fixed_items.push(id);
+            }
+        }
+        (start, self.fixed_items.len() as u32)
+    }
+
+    /// The rectangle of the cell at coordinates `(cx, cy)`, with outer cells extended to
+    /// infinity.
+    fn cell_rect(&self, (cx, cy): (u32, u32)) -> (Vec2, Vec2) {
         let x0 = if cx == 0 {
             f64::NEG_INFINITY
         } else {
@@ -123,14 +255,49 @@ impl Grid {
         (self.nx, self.ny)
     }
 
-    /// The cell holding point `p` (clamped to the grid).
+    /// Whether the layout is hashed (a table larger than about `4 N` cells).
+    pub fn is_hashed(&self) -> bool {
+        self.hashed.is_some()
+    }
+
+    /// The coordinates of the cell holding point `p` (clamped to the grid).
     #[inline]
-    pub fn cell_at(&self, p: Vec2) -> u32 {
+    fn coords_at(&self, p: Vec2) -> (u32, u32) {
         let cx = ((p.x - self.lo.x) / self.width).floor();
         let cy = ((p.y - self.lo.y) / self.height).floor();
         let cx = cx.clamp(0.0, f64::from(self.nx - 1)) as u32;
         let cy = cy.clamp(0.0, f64::from(self.ny - 1)) as u32;
-        cy * self.nx + cx
+        (cx, cy)
+    }
+
+    /// The coordinates of cell `c`.
+    fn coords(&self, c: u32) -> (u32, u32) {
+        match &self.hashed {
+            Some(h) => h.at[c as usize],
+            None => (c % self.nx, c / self.nx),
+        }
+    }
+
+    /// Puts ball `i` into the cell holding point `p`, and returns that cell.
+    pub fn insert_at(&mut self, i: u32, p: Vec2) -> u32 {
+        let (cx, cy) = self.coords_at(p);
+        let c = if self.hashed.is_some() {
+            self.cell_in_use(cx, cy)
+        } else {
+            cy * self.nx + cx
+        };
+        self.insert(i, c);
+        c
+    }
+
+    /// Moves ball `i` (which must be on the grid) into the cell holding point `p` if it is not
+    /// there already.
+    pub fn move_to(&mut self, i: u32, p: Vec2) {
+        let c = self.cell_of[i as usize];
+        if self.coords(c) != self.coords_at(p) {
+            self.remove_from(i, c);
+            self.insert_at(i, p);
+        }
     }
 
     /// The cell ball `i` is in, or `None` if it was removed.
@@ -145,6 +312,10 @@ impl Grid {
     pub fn insert(&mut self, i: u32, c: u32) {
         let c = c as usize;
         if self.count(c) == self.cap {
+            if self.cap == MAX_SLOTS {
+                self.spill_into(i, c as u32);
+                return;
+            }
             self.grow();
         }
         let k = self.count(c);
@@ -152,10 +323,17 @@ impl Grid {
         self.cell_of[i as usize] = c as u32;
     }
 
+    /// Puts ball `i` into the spill list of cell `c`, whose slots are full.
+    #[cold]
+    fn spill_into(&mut self, i: u32, c: u32) {
+        self.spill.entry(c).or_default().push(i);
+        self.cell_of[i as usize] = c;
+        self.general = true;
+    }
+
     /// Doubles every cell's slots (a cell overflowed: balls of very different sizes).
     fn grow(&mut self) {
         let cap = 2 * self.cap;
-        assert!(cap <= 128, "more than 128 ball centres in one grid cell");
         let cells = self.slots.len() / self.cap;
         let mut slots = vec![NIL; cap * cells];
         for c in 0..cells {
@@ -181,16 +359,34 @@ impl Grid {
         let c = c as usize;
         let n = self.count(c);
         let cell = &mut self.slots[c * self.cap..c * self.cap + n];
-        let k = cell
-            .iter()
-            .position(|&j| j == i)
-            .expect("a ball is in the cell it was put in");
-        cell[k] = cell[n - 1];
-        cell[n - 1] = NIL;
+        match cell.iter().position(|&j| j == i) {
+            Some(k) => {
+                cell[k] = cell[n - 1];
+                cell[n - 1] = NIL;
+            }
+            None => self.unspill(i, c as u32),
+        }
         self.cell_of[i as usize] = NIL;
     }
 
-    /// How many balls cell `c` holds.
+    /// Takes ball `i` out of the spill list of cell `c`.
+    #[cold]
+    fn unspill(&mut self, i: u32, c: u32) {
+        let list = self
+            .spill
+            .get_mut(&c)
+            .expect("a ball is in the cell it was put in");
+        let k = list
+            .iter()
+            .position(|&j| j == i)
+            .expect("a ball is in the cell it was put in");
+        list.swap_remove(k);
+        if list.is_empty() {
+            self.spill.remove(&c);
+        }
+    }
+
+    /// How many balls cell `c` holds in its slots.
     #[inline]
     fn count(&self, c: usize) -> usize {
         let cell = &self.slots[c * self.cap..(c + 1) * self.cap];
@@ -200,6 +396,10 @@ impl Grid {
     /// Starts loading the 3 × 3 block of cells around cell `c` (if it is a cell) into cache.
     #[inline]
     pub fn prefetch_near(&self, c: u32) {
+        if self.general {
+            self.prefetch_block(c);
+            return;
+        }
         if c >= self.nx * self.ny {
             return;
         }
@@ -217,6 +417,10 @@ impl Grid {
     /// in `c` itself).
     #[inline]
     pub fn for_each_near(&self, c: u32, mut f: impl FnMut(u32)) {
+        if self.general {
+            self.for_each_in_block(c, &mut f);
+            return;
+        }
         let (cx, cy) = (c % self.nx, c / self.nx);
         let x0 = cx.saturating_sub(1);
         let x1 = (cx + 1).min(self.nx - 1);
@@ -237,6 +441,10 @@ impl Grid {
     /// block around `from` (a ball whose centre moved from `from` to `to`).
     #[inline]
     pub fn for_each_entering(&self, from: u32, to: u32, mut f: impl FnMut(u32)) {
+        if self.general {
+            self.for_each_entering_block(from, to, &mut f);
+            return;
+        }
         let (fx, fy) = ((from % self.nx) as i64, (from / self.nx) as i64);
         let (tx, ty) = (to % self.nx, to / self.nx);
         for y in ty.saturating_sub(1)..=(ty + 1).min(self.ny - 1) {
@@ -254,23 +462,136 @@ impl Grid {
         }
     }
 
+    /// The ids of the 3 × 3 block of cells around cell `c`, `c` first (`NIL` where there is no
+    /// cell, and all `NIL` if `c` is no cell).
+    fn block(&self, c: u32) -> [u32; 9] {
+        let mut out = [NIL; 9];
+        match &self.hashed {
+            Some(h) => {
+                if let Some(around) = h.around.get(c as usize) {
+                    out[0] = c;
+                    out[1..].copy_from_slice(around);
+                }
+            }
+            None if c < self.nx * self.ny => {
+                let (cx, cy) = (i64::from(c % self.nx), i64::from(c / self.nx));
+                out[0] = c;
+                for (k, &(dx, dy)) in AROUND.iter().enumerate() {
+                    let (x, y) = (cx + i64::from(dx), cy + i64::from(dy));
+                    if (0..i64::from(self.nx)).contains(&x) && (0..i64::from(self.ny)).contains(&y)
+                    {
+                        out[k + 1] = (y * i64::from(self.nx) + x) as u32;
+                    }
+                }
+            }
+            None => {}
+        }
+        out
+    }
+
+    /// Calls `f` with every ball of cell `c`: its slots, then its spill list.
+    #[inline(always)]
+    fn for_each_in(&self, c: u32, f: &mut impl FnMut(u32)) {
+        let c = c as usize;
+        for &j in &self.slots[c * self.cap..(c + 1) * self.cap] {
+            if j != NIL {
+                f(j);
+            }
+        }
+        if !self.spill.is_empty() {
+            if let Some(list) = self.spill.get(&(c as u32)) {
+                list.iter().for_each(|&j| f(j));
+            }
+        }
+    }
+
+    /// [`Grid::prefetch_near`] through the cell ids.
+    #[inline(never)]
+    fn prefetch_block(&self, c: u32) {
+        let Some(h) = &self.hashed else {
+            for k in self.block(c) {
+                if k != NIL {
+                    prefetch(&self.slots[k as usize * self.cap]);
+                }
+            }
+            return;
+        };
+        if let Some(around) = h.around.get(c as usize) {
+            prefetch(&self.slots[c as usize * self.cap]);
+            // a missing neighbour (`NIL`) is past the end
+            for &k in around {
+                if let Some(slot) = self.slots.get(k as usize * self.cap) {
+                    prefetch(slot);
+                }
+            }
+        }
+    }
+
+    /// [`Grid::for_each_near`] through the cell ids.
+    #[inline(never)]
+    fn for_each_in_block(&self, c: u32, f: &mut impl FnMut(u32)) {
+        let Some(h) = &self.hashed else {
+            for k in self.block(c) {
+                if k != NIL {
+                    self.for_each_in(k, f);
+                }
+            }
+            return;
+        };
+        self.for_each_in(c, f);
+        for &k in &h.around[c as usize] {
+            if k != NIL {
+                self.for_each_in(k, f);
+            }
+        }
+    }
+
+    /// [`Grid::for_each_entering`] through the cell ids and their coordinates.
+    #[inline(never)]
+    fn for_each_entering_block(&self, from: u32, to: u32, f: &mut impl FnMut(u32)) {
+        let (fx, fy) = self.coords(from);
+        let (tx, ty) = self.coords(to);
+        let step = (i64::from(tx) - i64::from(fx), i64::from(ty) - i64::from(fy));
+        if let (Some(h), Some(k)) = (&self.hashed, STEPS.iter().position(|&d| d == step)) {
+            // a crossing into a cell next to it: the three cells on its far side
+            for e in ENTERING[k] {
+                let n = h.around[to as usize][e];
+                if n != NIL {
+                    self.for_each_in(n, f);
+                }
+            }
+            return;
+        }
+        let (fx, fy) = (i64::from(fx), i64::from(fy));
+        let block = self.block(to);
+        let (tx, ty) = (i64::from(tx), i64::from(ty));
+        for (&n, (dx, dy)) in block.iter().zip([(0, 0)].into_iter().chain(AROUND)) {
+            let (x, y) = (tx + i64::from(dx), ty + i64::from(dy));
+            if n != NIL && ((x - fx).abs() > 1 || (y - fy).abs() > 1) {
+                self.for_each_in(n, f);
+            }
+        }
+    }
+
     /// The fixed objects a ball whose centre is in cell `c` may touch before it leaves the cell.
     #[inline]
     pub fn fixed_near(&self, c: u32) -> &[u32] {
         if self.has_fixed[c as usize / 64] & (1 << (c % 64)) == 0 {
             return &[];
         }
-        let (a, b) = (
-            self.fixed_start[c as usize] as usize,
-            self.fixed_start[c as usize + 1] as usize,
-        );
-        &self.fixed_items[a..b]
+        let (a, b) = self.fixed_span[c as usize];
+        &self.fixed_items[a as usize..b as usize]
     }
 
-    /// When a centre moving along `position + (t - t0) velocity` leaves cell `c`, and the cell it
-    /// enters; `None` if it never leaves (at rest, or heading out through an outer cell).
+    /// When a centre in cell `c`, moving along `position + (t - t0) velocity`, leaves the cell,
+    /// and the cell it enters; `None` if it never leaves (at rest, or heading out through an
+    /// outer cell). In the hashed layout the cell entered is brought into use: it stays while a
+    /// cell next to it holds a ball.
     #[inline]
-    pub fn exit(&self, c: u32, position: Vec2, velocity: Vec2, t0: f64) -> Option<(f64, u32)> {
+    pub fn exit(&mut self, c: u32, position: Vec2, velocity: Vec2, t0: f64) -> Option<(f64, u32)> {
+        if self.general {
+            return self.exit_general(c, position, velocity, t0);
+        }
         let (cx, cy) = (c % self.nx, c / self.nx);
         let mut best: Option<(f64, u32)> = None;
         if velocity.x > 0.0 && cx + 1 < self.nx {
@@ -295,12 +616,241 @@ impl Grid {
         }
     }
 
+    /// [`Grid::exit`] through the cell coordinates.
+    #[inline(never)]
+    fn exit_general(
+        &mut self,
+        c: u32,
+        position: Vec2,
+        velocity: Vec2,
+        t0: f64,
+    ) -> Option<(f64, u32)> {
+        let (cx, cy) = self.coords(c);
+        // the time, and the neighbour entered as its place in `AROUND`
+        let mut best: Option<(f64, usize)> = None;
+        if velocity.x > 0.0 && cx + 1 < self.nx {
+            let b = self.lo.x + f64::from(cx + 1) * self.width;
+            best = Some((t0 + (b - position.x) / velocity.x, 4));
+        } else if velocity.x < 0.0 && cx > 0 {
+            let b = self.lo.x + f64::from(cx) * self.width;
+            best = Some((t0 + (b - position.x) / velocity.x, 3));
+        }
+        let y = if velocity.y > 0.0 && cy + 1 < self.ny {
+            let b = self.lo.y + f64::from(cy + 1) * self.height;
+            Some((t0 + (b - position.y) / velocity.y, 6))
+        } else if velocity.y < 0.0 && cy > 0 {
+            let b = self.lo.y + f64::from(cy) * self.height;
+            Some((t0 + (b - position.y) / velocity.y, 1))
+        } else {
+            None
+        };
+        let (t, k) = match (best, y) {
+            (Some(a), Some(b)) => Some(if b.0 < a.0 { b } else { a }),
+            (a, b) => a.or(b),
+        }?;
+        let (dx, dy) = AROUND[k];
+        let (x, y) = (cx.wrapping_add_signed(dx), cy.wrapping_add_signed(dy));
+        let to = match &self.hashed {
+            None => y * self.nx + x,
+            Some(h) if h.around[c as usize][k] != NIL => h.around[c as usize][k],
+            Some(_) => self.cell_in_use(x, y),
+        };
+        Some((t, to))
+    }
+
+    /// The id of the cell at coordinates `(x, y)` in the hashed layout, brought into use if it
+    /// was not.
+    fn cell_in_use(&mut self, x: u32, y: u32) -> u32 {
+        let h = self.hashed.as_mut().expect("hashed layout");
+        let key = u64::from(y) << 32 | u64::from(x);
+        if let Some(&c) = h.ids.get(&key) {
+            return c;
+        }
+        if h.free.is_empty() && h.ids.len() >= h.limit {
+            self.sweep();
+        }
+        let h = self.hashed.as_mut().expect("hashed layout");
+        let c = match h.free.pop() {
+            Some(c) => c,
+            None => {
+                let c = h.at.len() as u32;
+                h.at.push((NIL, NIL));
+                h.around.push([NIL; 8]);
+                self.slots.resize(self.slots.len() + self.cap, NIL);
+                self.has_fixed.resize((c as usize + 1).div_ceil(64), 0);
+                c
+            }
+        };
+        h.ids.insert(key, c);
+        h.at[c as usize] = (x, y);
+        for (k, &(dx, dy)) in AROUND.iter().enumerate() {
+            let (ax, ay) = (i64::from(x) + i64::from(dx), i64::from(y) + i64::from(dy));
+            if ax < 0 || ay < 0 {
+                continue;
+            }
+            if let Some(&n) = h.ids.get(&((ay as u64) << 32 | ax as u64)) {
+                h.around[c as usize][k] = n;
+                h.around[n as usize][7 - k] = c;
+            }
+        }
+        let span = h.block_fixed[((y / h.side) * h.blocks_x + x / h.side) as usize];
+        match self.fixed_span.get_mut(c as usize) {
+            Some(s) => *s = span,
+            None => self.fixed_span.push(span),
+        }
+        if span.1 > span.0 {
+            self.has_fixed[c as usize / 64] |= 1 << (c % 64);
+        }
+        c
+    }
+
+    /// Recycles the ids of the hashed cells with no ball in their 3 × 3 block. A cell that a
+    /// ball's next crossing enters is next to that ball's cell, so it stays.
+    fn sweep(&mut self) {
+        let idle: Vec<u32> = (0..self.slots.len() / self.cap)
+            .map(|c| c as u32)
+            .filter(|&c| self.coords(c).0 != NIL)
+            .filter(|&c| self.block(c).iter().all(|&k| k == NIL || self.is_empty(k)))
+            .collect();
+        let h = self.hashed.as_mut().expect("hashed layout");
+        for c in idle {
+            let (x, y) = h.at[c as usize];
+            h.ids.remove(&(u64::from(y) << 32 | u64::from(x)));
+            for (k, n) in h.around[c as usize].into_iter().enumerate() {
+                if n != NIL {
+                    h.around[n as usize][7 - k] = NIL;
+                }
+            }
+            h.around[c as usize] = [NIL; 8];
+            h.at[c as usize] = (NIL, NIL);
+            self.has_fixed[c as usize / 64] &= !(1 << (c % 64));
+            h.free.push(c);
+        }
+    }
+
+    /// Whether cell `c` holds no ball.
+    fn is_empty(&self, c: u32) -> bool {
+        self.slots[c as usize * self.cap] == NIL && !self.spill.contains_key(&c)
+    }
+
     /// Bytes of memory the grid holds.
     pub fn memory_bytes(&self) -> usize {
-        4 * (self.slots.len()
-            + self.cell_of.len()
-            + self.fixed_start.len()
-            + self.fixed_items.len())
-            + 8 * self.has_fixed.len()
+        let hashed = self.hashed.as_ref().map_or(0, |h| {
+            h.ids.capacity() * 16
+                + h.at.len() * 8
+                + h.around.len() * 32
+                + 4 * h.free.len()
+                + 8 * h.block_fixed.len()
+        });
+        4 * (self.slots.len() + self.cell_of.len() + self.fixed_items.len())
+            + 8 * (self.fixed_span.len() + self.has_fixed.len())
+            + self.spill.values().map(|l| 4 * l.capacity()).sum::<usize>()
+            + hashed
+    }
+}
+
+/// Whether more than [`CROWDED`] of `centres` fall in one cell of an `nx` × `ny` grid over
+/// `table`.
+fn crowded(table: &Table, centres: &[Vec2], (nx, ny): (u32, u32)) -> bool {
+    let span = table.hi - table.lo;
+    let (w, h) = (span.x / f64::from(nx), span.y / f64::from(ny));
+    let mut count = vec![0usize; (nx * ny) as usize];
+    centres.iter().any(|p| {
+        let cx = ((p.x - table.lo.x) / w)
+            .floor()
+            .clamp(0.0, f64::from(nx - 1)) as u32;
+        let cy = ((p.y - table.lo.y) / h)
+            .floor()
+            .clamp(0.0, f64::from(ny - 1)) as u32;
+        let k = &mut count[(cy * nx + cx) as usize];
+        *k += 1;
+        *k > CROWDED
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::{BallSpec, CushionSpec, Scenario};
+
+    /// A `side` × `side` box of cushions with `n` balls of radius 1 (their places do not matter
+    /// to the grid's layout).
+    fn table(n: usize, side: f64) -> Table {
+        let c = |a: (f64, f64), b: (f64, f64)| CushionSpec {
+            from: Vec2::new(a.0, a.1),
+            to: Vec2::new(b.0, b.1),
+            elasticity: 1.0,
+        };
+        let ball = BallSpec {
+            position: Vec2::new(5.0, 5.0),
+            velocity: Vec2::ZERO,
+            radius: 1.0,
+            mass: 1.0,
+        };
+        Table::new(&Scenario {
+            name: "grid".to_string(),
+            until: 1.0,
+            balls: vec![ball; n],
+            cushions: vec![
+                c((0.0, 0.0), (0.0, side)),
+                c((0.0, side), (side, side)),
+                c((side, side), (side, 0.0)),
+                c((side, 0.0), (0.0, 0.0)),
+            ],
+            pockets: Vec::new(),
+            sectors: None,
+        })
+    }
+
+    fn near(g: &Grid, c: u32) -> Vec<u32> {
+        let mut seen = Vec::new();
+        g.for_each_near(c, |j| seen.push(j));
+        seen.sort_unstable();
+        seen
+    }
+
+    #[test]
+    fn any_number_of_centres_share_a_cell() {
+        let n = 300;
+        for (side, hashed) in [(10.0, false), (4000.0, true)] {
+            let mut g = Grid::new(&table(n, side), &vec![Vec2::new(5.0, 5.0); n], 1.0, 2.0);
+            assert_eq!(g.is_hashed(), hashed);
+            let cells: Vec<u32> = (0..n as u32)
+                .map(|i| g.insert_at(i, Vec2::new(5.0, 5.0)))
+                .collect();
+            assert!(cells.iter().all(|&c| c == cells[0]));
+            assert_eq!(near(&g, cells[0]), (0..n as u32).collect::<Vec<_>>());
+            for i in (0..n as u32).step_by(2) {
+                g.remove(i);
+            }
+            let odd: Vec<u32> = (1..n as u32).step_by(2).collect();
+            assert_eq!(near(&g, cells[0]), odd);
+            // a neighbour sees them all; a cell two away sees none of them
+            let to = g.insert_at(0, Vec2::new(7.5, 5.0));
+            let mut entering = Vec::new();
+            g.for_each_entering(to, cells[0], |j| entering.push(j));
+            assert!(entering.is_empty());
+            assert!(near(&g, to).len() == odd.len() + 1);
+        }
+    }
+
+    #[test]
+    fn hashed_cells_are_recycled() {
+        let n = 100;
+        let mut g = Grid::new(&table(n, 4000.0), &vec![Vec2::new(5.0, 5.0); n], 1.0, 2.0);
+        assert!(g.is_hashed());
+        let mut c = g.insert_at(0, Vec2::new(1.0, 1.0));
+        let (mut p, v) = (Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.7));
+        for _ in 0..2000 {
+            let (t, to) = g.exit(c, p, v, 0.0).expect("heading into the table");
+            p = p + t * v;
+            g.remove_from(0, c);
+            g.insert(0, to);
+            assert_eq!(g.coords(to), g.coords_at(p + 1e-9 * v));
+            c = to;
+        }
+        let h = g.hashed.as_ref().expect("hashed");
+        assert!(h.at.len() <= h.limit + 1, "{} cells", h.at.len());
+        assert!(p.x > 2000.0);
     }
 }

@@ -66,9 +66,10 @@ impl TimeStep {
         let table = Table::new(s);
         let balls = BallState::initial(s, opts.span.start);
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let mut grid = Grid::new(&table, balls.len(), rmax, 2.0 * rmax);
+        let centres: Vec<_> = balls.iter().map(|b| b.traj.position).collect();
+        let mut grid = Grid::new(&table, &centres, rmax, 2.0 * rmax);
         for (i, b) in balls.iter().enumerate() {
-            grid.insert(i as u32, grid.cell_at(b.traj.position));
+            grid.insert_at(i as u32, b.traj.position);
         }
         TimeStep {
             table,
@@ -156,8 +157,7 @@ impl TimeStep {
                 velocity: b.traj.velocity,
                 t0: now,
             };
-            let c = self.grid.cell_at(b.traj.position);
-            self.grid.insert(i, c);
+            self.grid.insert_at(i, b.traj.position);
             self.emit(EventKind::BallPocket, i, f, counts, obs)?;
         }
         Ok(())
@@ -285,11 +285,7 @@ impl TimeStep {
                 velocity: b.traj.velocity,
                 t0: self.t,
             };
-            let c = self.grid.cell_at(b.traj.position);
-            if self.grid.cell_of(i) != Some(c) {
-                self.grid.remove(i);
-                self.grid.insert(i, c);
-            }
+            self.grid.move_to(i, b.traj.position);
         }
     }
 
