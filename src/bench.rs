@@ -331,20 +331,18 @@ fn proc_status_mib(field: &str) -> f64 {
         .map_or(0.0, |kb| kb / 1024.0)
 }
 
-/// The thesis gas (seed 1) of `balls` balls, at `area_fraction` where given; returns the ball
-/// count with it.
+/// The thesis gas (seed 1) of `balls` balls, at `area_fraction` where given.
 fn thesis_gas(
     balls: usize,
     area_fraction: Option<f64>,
-) -> Result<(usize, crate::scenario::Scenario), BenchError> {
+) -> Result<crate::scenario::Scenario, BenchError> {
     let params = Params {
         balls: Some(balls),
         seed: Some(1),
         area_fraction,
         ..Params::default()
     };
-    let scenario = builtin::build("gas", &params).map_err(BenchError::Scenario)?;
-    Ok((balls, scenario))
+    builtin::build("gas", &params).map_err(BenchError::Scenario)
 }
 
 /// Measures one configuration.
@@ -355,7 +353,7 @@ pub fn measure(
     cell_diameters: f64,
 ) -> Result<BenchRow, BenchError> {
     let start = Instant::now();
-    let (n_balls, scenario) = thesis_gas(balls, Some(area_fraction))?;
+    let (n_balls, scenario) = (balls, thesis_gas(balls, Some(area_fraction))?);
     let opts = Options {
         cell_diameters,
         ..Options::default()
@@ -553,7 +551,7 @@ pub fn measure_objects(
     balls: usize,
     sectors: Option<crate::run::SectorChoice>,
 ) -> Result<ObjectsRow, BenchError> {
-    let (n_balls, mut scenario) = thesis_gas(balls, sectors.map(|_| 0.3))?;
+    let (n_balls, mut scenario) = (balls, thesis_gas(balls, sectors.map(|_| 0.3))?);
     let start = Instant::now();
     if let Some(choice) = sectors {
         scenario.until = SECTORED_WARM_UP + SECTORED_WINDOW;
@@ -628,7 +626,7 @@ pub fn measure_time_warp(
     workers: &[usize],
 ) -> Result<Vec<TwRow>, BenchError> {
     use crate::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
-    let (n_balls, scenario) = thesis_gas(balls, None)?;
+    let (n_balls, scenario) = (balls, thesis_gas(balls, None)?);
     let mut rows: Vec<TwRow> = Vec::new();
     for workers in std::iter::once(0).chain(workers.iter().copied()) {
         let engine = match workers {
