@@ -673,6 +673,7 @@ impl Model for Pool {
     type Msg = PoolMsg;
     type State = PoolState;
     type Output = PoolOutput;
+    type Undo = ();
 
     fn kind_names(&self) -> &'static [&'static str] {
         const NAMES: [&str; 5] = [

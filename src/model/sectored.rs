@@ -847,6 +847,7 @@ impl Model for Sectored {
     type Msg = SecMsg;
     type State = SecState;
     type Output = Event;
+    type Undo = ();
 
     fn kind_names(&self) -> &'static [&'static str] {
         &KIND_NAMES

@@ -81,6 +81,7 @@ impl Model for Network {
     type Msg = Msg;
     type State = Station;
     type Output = ();
+    type Undo = ();
 
     fn kind_names(&self) -> &'static [&'static str] {
         &["Arrive", "Done"]

@@ -130,6 +130,23 @@ pub struct Envelope<M> {
 /// The most kinds of state [`Model::state_class`] tells apart.
 pub const STATE_CLASSES: usize = 4;
 
+/// How an optimistic executor keeps what it needs to undo one of an object's batches
+/// ([`Model::saving`]).
+pub enum Saving<S, U> {
+    /// A copy of the whole state before every batch that may be undone (Jefferson 1985): no
+    /// work for the model, a copy's worth of work for the executor.
+    Copy,
+    /// Only the old values the handler records with [`Ctx::save`] before it changes them
+    /// (incremental state saving): a rollback hands the batch's records to `restore`, latest
+    /// first, and each puts its bits back. For objects with large states of which a batch
+    /// changes little. Restoring saved values, never undoing arithmetic, keeps every result
+    /// bit-identical.
+    Incremental {
+        /// Puts one record's old values back into the state.
+        restore: fn(&mut S, U),
+    },
+}
+
 /// A simulation model for the kernel: message and state types and the objects' behaviour.
 pub trait Model {
     /// The model's virtual time ([`PlainTime`] unless it orders the events of an instant
@@ -141,6 +158,10 @@ pub trait Model {
     type State: Clone + Serialize + DeserializeOwned;
     /// What objects report as they go (physical events, drawings): committed output.
     type Output: Serialize + DeserializeOwned;
+    /// A record of old values, written by [`Ctx::save`] before a batch changes them, for
+    /// objects saved incrementally ([`Model::saving`]); `()` for a model whose states are
+    /// copied whole.
+    type Undo: Clone + Send;
 
     /// Names of the message types, indexed by [`Model::kind`], for the statistics.
     fn kind_names(&self) -> &'static [&'static str];
@@ -160,6 +181,13 @@ pub trait Model {
     fn state_class(&self, obj: u32) -> usize {
         let _ = obj;
         0
+    }
+    /// How an optimistic executor saves object `obj`'s state before a batch it may undo: a
+    /// copy (the default) or the records the handler writes ([`Saving::Incremental`]). The
+    /// answer must not change over a run.
+    fn saving(&self, obj: u32) -> Saving<Self::State, Self::Undo> {
+        let _ = obj;
+        Saving::Copy
     }
     /// Sets object `me` up at the start time; it may send messages.
     fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, state: &mut Self::State);
@@ -254,6 +282,8 @@ pub struct Ctx<'a, M: Model + ?Sized> {
     pub cancelled: Vec<Handle>,
     /// Output this batch produced.
     pub output: Vec<M::Output>,
+    /// Where [`Ctx::save`] writes, when the executor keeps the batch's old values.
+    journal: Option<&'a mut Vec<M::Undo>>,
     /// Set by an optimistic executor: a batch may run on a state that a rollback will undo.
     speculative: bool,
     /// A send into the past this speculative batch tried (and that was dropped).
@@ -272,6 +302,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             sent: Vec::new(),
             cancelled: Vec::new(),
             output: Vec::new(),
+            journal: None,
             speculative: false,
             into_past: None,
         }
@@ -293,6 +324,30 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     pub fn named(mut self, uids: &'a mut u64) -> Ctx<'a, M> {
         self.uids = Some(uids);
         self
+    }
+
+    /// Keeps the old values that [`Ctx::save`] records in `journal` (an optimistic executor's
+    /// batch of an object saved incrementally).
+    pub fn journaled(mut self, journal: &'a mut Vec<M::Undo>) -> Ctx<'a, M> {
+        self.journal = Some(journal);
+        self
+    }
+
+    /// Records old values of the state, made by `undo`, before the handler changes them: an
+    /// object saved incrementally ([`Model::saving`]) must save everything a batch changes
+    /// before changing it, and its rollback restores the records, latest first. `undo` runs
+    /// only when the executor keeps the record (not on the sequential executor, nor for a
+    /// batch that can no longer be undone), so saving costs nothing there.
+    #[inline]
+    pub fn save(&mut self, undo: impl FnOnce() -> M::Undo) {
+        if let Some(journal) = self.journal.as_deref_mut() {
+            journal.push(undo());
+        }
+    }
+
+    /// Whether [`Ctx::save`] keeps its records in this batch.
+    pub fn saves(&self) -> bool {
+        self.journal.is_some()
     }
 
     /// The object handling the batch.

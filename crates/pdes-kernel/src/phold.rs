@@ -114,6 +114,7 @@ impl Model for Phold {
     type Msg = ();
     type State = PholdState;
     type Output = ();
+    type Undo = ();
 
     fn kind_names(&self) -> &'static [&'static str] {
         &["Event"]

@@ -218,6 +218,7 @@ mod tests {
         type Msg = bool;
         type State = Option<Handle>;
         type Output = ();
+        type Undo = ();
 
         fn kind_names(&self) -> &'static [&'static str] {
             &["Tick"]

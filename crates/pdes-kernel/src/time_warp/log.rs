@@ -112,6 +112,20 @@ impl<T> Log<T> {
         (next != NONE).then(|| self.entry(next).item.as_ref().expect("live"))
     }
 
+    /// The records of `chain` after its oldest, latest first.
+    pub fn after_first_newest_first<'a>(&'a self, chain: &Chain) -> impl Iterator<Item = &'a T> {
+        let first = chain.first;
+        let mut n = chain.last;
+        std::iter::from_fn(move || {
+            if n == first {
+                return None;
+            }
+            let e = self.entry(n);
+            n = e.prev;
+            Some(e.item.as_ref().expect("live"))
+        })
+    }
+
     /// Takes the latest record of `chain`.
     pub fn pop_last(&mut self, chain: &mut Chain) -> Option<T> {
         (chain.last != NONE).then(|| self.unlink(chain, chain.last))
@@ -181,6 +195,8 @@ mod tests {
         assert_eq!(log.pop_first(&mut a), Some(10));
         assert_eq!(log.front(), Some((1, &20)));
         assert_eq!(log.last(&b), Some(&22));
+        let later: Vec<u32> = log.after_first_newest_first(&b).copied().collect();
+        assert_eq!(later, [22, 21]);
         // a's oldest left a hole at the front, trimmed; b's latest one at the back, trimmed
         assert_eq!((log.len(), log.slots()), (6, 6));
         assert_eq!(log.pop_first(&mut a), Some(11));

@@ -436,6 +436,7 @@ mod tests {
         type Msg = ();
         type State = u32;
         type Output = ();
+        type Undo = ();
 
         fn kind_names(&self) -> &'static [&'static str] {
             &["Nothing"]
@@ -737,6 +738,7 @@ mod tests {
         type Msg = u64;
         type State = (u64, Option<crate::Handle>);
         type Output = ();
+        type Undo = ();
 
         fn kind_names(&self) -> &'static [&'static str] {
             &["Pass"]

@@ -11,8 +11,8 @@ use super::window::AutoWindow;
 use crate::prefetch::{prefetch, prefetch_all};
 use crate::queue::{Queue, Ranked};
 use crate::{
-    uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, Time, VTime, RESERVED_PER_OBJECT,
-    STATE_CLASSES,
+    uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, Saving, Time, VTime,
+    RESERVED_PER_OBJECT, STATE_CLASSES,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -105,11 +105,13 @@ struct Input {
 
 /// Vectors of finished batches, kept for the next ones: a worker runs millions of batches, and
 /// each would otherwise allocate and free the same few small vectors.
-struct Spare<T, Msg, State> {
+struct Spare<T, Msg, State, Undo> {
     /// Saved states freed by commits and rollbacks, by [`Model::state_class`]: a batch's state
     /// is saved into one of its kind with `clone_from`, which reuses the buffers the state
     /// holds instead of allocating.
     states: [Vec<State>; STATE_CLASSES],
+    /// Journals of objects saved incrementally ([`Saving::Incremental`]).
+    journals: Vec<Vec<Undo>>,
     inputs: Vec<Vec<Input>>,
     batches: Vec<Vec<Envelope<Msg>>>,
     sent: Vec<Vec<(Sent<T>, u16)>>,
@@ -127,10 +129,11 @@ const SPARE: usize = 64;
 /// runs ahead (two GVT intervals on threads), so that a worker saves states without allocating.
 const SPARE_STATES: usize = 4096;
 
-impl<T: Time, Msg, State> Default for Spare<T, Msg, State> {
+impl<T: Time, Msg, State, Undo> Default for Spare<T, Msg, State, Undo> {
     fn default() -> Self {
         Spare {
             states: Default::default(),
+            journals: Vec::new(),
             inputs: Vec::new(),
             batches: Vec::new(),
             sent: Vec::new(),
@@ -183,13 +186,19 @@ const ASK_SWEEP: usize = 2;
 /// A worker joins a sweep another asked for when they are over a quarter of its heap.
 const JOIN_SWEEP: usize = 4;
 
+/// What undoes a batch's changes to its object's state ([`Model::saving`]).
+enum Saved<M: Model> {
+    /// The whole state before the batch, and its kind ([`Model::state_class`]).
+    Copy(u8, M::State),
+    /// The old values the handler recorded, oldest first, and what puts one back.
+    Journal(Vec<M::Undo>, fn(&mut M::State, M::Undo)),
+}
+
 /// A batch an object ran that is not committed yet.
 struct Done<M: Model> {
     time: VTime<M::Time>,
-    /// The object's state before it.
-    pre_state: M::State,
-    /// Its kind ([`Model::state_class`]).
-    class: u8,
+    /// What restores the object's state before it.
+    saved: Saved<M>,
     pre_seq: u64,
     /// The messages it handled: their names, and the envelopes the model saw.
     inputs: Vec<Input>,
@@ -230,8 +239,8 @@ struct Taken<M: Model> {
     cancellable: bool,
     /// The object of the message after the batch, if any.
     next: Option<u32>,
-    /// The object's state before the batch and its kind, when it runs speculatively.
-    saved: Option<(u8, M::State)>,
+    /// What restores the object's state before the batch, when it runs speculatively.
+    saved: Option<Saved<M>>,
 }
 
 /// One object (a logical process) on its worker.
@@ -309,7 +318,7 @@ pub struct Worker<M: Model> {
     /// Ops for this worker's objects.
     local_ops: Vec<Op<M::Time, M::Msg>>,
     /// Vectors for the next batches.
-    spare: Spare<M::Time, M::Msg, M::State>,
+    spare: Spare<M::Time, M::Msg, M::State, M::Undo>,
     outbox: Vec<Vec<Op<M::Time, M::Msg>>>,
     /// Chaos mode: its random stream and the ops it holds back.
     chaos: Option<Chaos<M::Time, M::Msg>>,
@@ -613,7 +622,19 @@ impl<M: Model> Worker<M> {
             let d = *self.log.pop_last(&mut lp.history).expect("a batch to undo");
             self.uncommitted -= 1;
             self.stats.rolled_back += 1;
-            let undone = std::mem::replace(&mut lp.state, d.pre_state);
+            match d.saved {
+                Saved::Copy(class, pre_state) => {
+                    let undone = std::mem::replace(&mut lp.state, pre_state);
+                    self.give_state(class, undone);
+                }
+                Saved::Journal(mut journal, restore) => {
+                    while let Some(undo) = journal.pop() {
+                        restore(&mut lp.state, undo);
+                    }
+                    give(&mut self.spare.journals, journal);
+                }
+            }
+            let lp = &mut self.lps[li];
             lp.seq = d.pre_seq;
             let to = lp.id;
             let (mut inputs, mut batch, mut sent) = (d.inputs, d.batch, d.sent);
@@ -642,13 +663,16 @@ impl<M: Model> Worker<M> {
                 self.route(op);
             }
             give(&mut self.spare.cancels, cancels);
-            self.give_state(d.class, undone);
         }
     }
 
-    /// A copy of the state of object `id` (local `li`), to restore if its next batch is rolled
-    /// back, with its kind ([`Model::state_class`]), for [`Worker::give_state`].
-    fn save_state(&mut self, model: &M, id: u32, li: usize) -> (u8, M::State) {
+    /// What will restore the state of object `id` (local `li`) if its next batch is rolled
+    /// back: a copy, with its kind ([`Model::state_class`]) for [`Worker::give_state`], or an
+    /// empty journal for the handler's records ([`Saving::Incremental`]).
+    fn save_state(&mut self, model: &M, id: u32, li: usize) -> Saved<M> {
+        if let Saving::Incremental { restore } = model.saving(id) {
+            return Saved::Journal(take(&mut self.spare.journals), restore);
+        }
         let class = model.state_class(id).min(STATE_CLASSES - 1);
         let state = &self.lps[li].state;
         let copy = match self.spare.states[class].pop() {
@@ -658,7 +682,15 @@ impl<M: Model> Worker<M> {
             }
             None => state.clone(),
         };
-        (class as u8, copy)
+        Saved::Copy(class as u8, copy)
+    }
+
+    /// Frees what restored a committed batch's state, for later batches to reuse.
+    fn give_saved(&mut self, saved: Saved<M>) {
+        match saved {
+            Saved::Copy(class, state) => self.give_state(class, state),
+            Saved::Journal(journal, _) => give(&mut self.spare.journals, journal),
+        }
     }
 
     /// Keeps a saved state no batch needs any more, for [`Worker::save_state`] to reuse.
@@ -762,6 +794,9 @@ impl<M: Model> Worker<M> {
         let lp = &mut self.lps[li];
         let (pre_seq, first) = (lp.seq, lp.uids);
         let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq).named(&mut lp.uids);
+        if let Some(Saved::Journal(journal, _)) = &mut taken.saved {
+            ctx = ctx.journaled(journal);
+        }
         ctx.sent = std::mem::take(&mut self.spare.pending);
         model.handle(&mut ctx, to, &mut lp.state, &taken.batch);
         let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
@@ -950,11 +985,9 @@ impl<M: Model> Worker<M> {
         if self.high.as_ref().is_none_or(|h| *h < time) {
             self.high = Some(time.clone());
         }
-        let (class, pre_state) = taken.saved.expect("saved: the batch is not final");
         let done = Done {
             time,
-            pre_state,
-            class,
+            saved: taken.saved.expect("saved: the batch is not final"),
             pre_seq: did.pre_seq,
             inputs: taken.inputs,
             batch: taken.batch,
@@ -1207,7 +1240,7 @@ impl<M: Model> Worker<M> {
         give(&mut self.spare.inputs, d.inputs);
         give(&mut self.spare.batches, d.batch);
         give(&mut self.spare.cancels, d.cancels);
-        self.give_state(d.class, d.pre_state);
+        self.give_saved(d.saved);
         self.keep_for_collector(d.time, self.lps[li].id, state, d.output);
     }
 
@@ -1254,7 +1287,7 @@ impl<M: Model> Worker<M> {
         }
         let observed = self.ship && model.observed(self.lps[li].id);
         loop {
-            let lp = &mut self.lps[li];
+            let lp = &self.lps[li];
             if !self
                 .log
                 .first(&lp.history)
@@ -1262,17 +1295,36 @@ impl<M: Model> Worker<M> {
             {
                 break;
             }
-            let state = observed.then(|| match self.log.second(&lp.history) {
-                Some(next) => next.pre_state.clone(),
-                None => lp.state.clone(),
-            });
+            let state = observed.then(|| self.state_after_first(li));
             let d = self
                 .log
-                .pop_first(&mut lp.history)
+                .pop_first(&mut self.lps[li].history)
                 .expect("a batch to commit");
             self.uncommitted -= 1;
             self.commit(li, d, state);
         }
+    }
+
+    /// The state of local object `li` after its oldest uncommitted batch: the copy saved
+    /// before the next one, or the state now with the records of every later batch undone,
+    /// latest first.
+    fn state_after_first(&self, li: usize) -> M::State {
+        let lp = &self.lps[li];
+        if let Some(Saved::Copy(_, state)) = self.log.second(&lp.history).map(|d| &d.saved) {
+            return state.clone();
+        }
+        let mut state = lp.state.clone();
+        for d in self.log.after_first_newest_first(&lp.history) {
+            match &d.saved {
+                Saved::Copy(_, before) => state.clone_from(before),
+                Saved::Journal(journal, restore) => {
+                    for undo in journal.iter().rev() {
+                        restore(&mut state, undo.clone());
+                    }
+                }
+            }
+        }
+        state
     }
 
     /// Commits optimistic batches, oldest run first, that nothing can undo any more: before
