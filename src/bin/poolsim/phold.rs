@@ -33,6 +33,9 @@ pub struct PholdArgs {
     /// Time Warp workers per rank (default: this machine's cores).
     #[arg(long)]
     pub workers: Option<usize>,
+    /// Time Warp: run every batch as undoable (no final batches), to measure optimism alone.
+    #[arg(long = "tw-pure")]
+    pub tw_pure: bool,
     /// End time.
     #[arg(long, default_value_t = 100.0)]
     pub end: f64,
@@ -90,8 +93,14 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
             }
             None
         }
-        PholdEngine::TimeWarp => Some(tw_workers(a.workers)?),
+        PholdEngine::TimeWarp => Some(pdes_kernel::time_warp::TwConfig {
+            final_batches: !a.tw_pure,
+            ..tw_workers(a.workers)?
+        }),
     };
+    if a.tw_pure && tw.is_none() {
+        return Err(usage("--tw-pure: only the time-warp engine takes it"));
+    }
     if tw.is_some() {
         poolsim::memory::transparent_huge_pages(false);
     }

@@ -124,7 +124,7 @@ struct Spare<T, Msg, State, Undo> {
 }
 
 /// Vectors of each kind kept at most.
-const SPARE: usize = 64;
+const SPARE: usize = 4096;
 /// Saved states of each kind kept at most: as many as the uncommitted batches of a worker that
 /// runs ahead (two GVT intervals on threads), so that a worker saves states without allocating.
 const SPARE_STATES: usize = 4096;
@@ -341,7 +341,7 @@ pub struct Worker<M: Model> {
     /// Uncommitted batches in the order they ran (committed early from the front), each
     /// record boxed: the log's slots stay small, and a commit moves a pointer, not the record
     /// (moved out of the log and into the commit, a record was copied three times).
-    log: Log<Box<Done<M>>>,
+    log: Log<Done<M>>,
     /// The floor this worker published last (with final batches only).
     published: Floor,
     /// Whether batches may run as final ([`TwConfig::final_batches`]).
@@ -619,7 +619,7 @@ impl<M: Model> Worker<M> {
         self.stats.rollbacks += 1;
         while self.last_time(li).is_some_and(|t| t >= time) {
             let lp = &mut self.lps[li];
-            let d = *self.log.pop_last(&mut lp.history).expect("a batch to undo");
+            let d = self.log.pop_last(&mut lp.history).expect("a batch to undo");
             self.uncommitted -= 1;
             self.stats.rolled_back += 1;
             match d.saved {
@@ -997,7 +997,7 @@ impl<M: Model> Worker<M> {
             output: did.output,
             into_past: did.into_past,
         };
-        self.log.push(&mut lp.history, li as u32, Box::new(done));
+        self.log.push(&mut lp.history, li as u32, done);
         self.uncommitted += 1;
         self.stats.peak_uncommitted = self.stats.peak_uncommitted.max(self.uncommitted as u64);
         for (n, p) in (did.uids + 1..).zip(sent.drain(..)) {
@@ -1223,9 +1223,7 @@ impl<M: Model> Worker<M> {
     /// Commits one optimistic batch of local object `li`: counts it and its sends, frees its
     /// records, and keeps for the collector what its sinks see (`state` is the object's state
     /// after it, when observed).
-    // the record stays in the box the log held: taken out, its 350 bytes would be copied
-    #[allow(clippy::boxed_local)]
-    fn commit(&mut self, li: usize, mut d: Box<Done<M>>, state: Option<M::State>) {
+    fn commit(&mut self, li: usize, mut d: Done<M>, state: Option<M::State>) {
         self.count_committed(d.into_past.take(), d.batch.len(), d.cancel_calls as usize);
         // its cancellations are final now: those of messages here become retractions
         for h in &d.cancels {
