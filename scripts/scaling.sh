@@ -2,7 +2,8 @@
 # Time Warp scaling of poolsim on the machine it runs on.
 #
 # Usage: scripts/scaling.sh [--balls N] [--until T] [--phold-objects N] [--phold-end T]
-#          [--phold-partitions N] [--workers LIST | --max-workers N] [--repeats N]
+#          [--phold-partitions N] [--phold-remote R] [--phold-lookahead L]
+#          [--workers LIST | --max-workers N] [--repeats N]
 #          [--models gas,phold] [--mpi] [--cpus LIST] [--timeout S]
 #          [--no-build | --binary PATH] [--out FILE]
 #
@@ -36,6 +37,8 @@
 #   --phold-objects N     PHOLD objects (default 16384)
 #   --phold-end T         PHOLD end time (default 10)
 #   --phold-partitions N  PHOLD partitions in every row (default: the largest worker/rank count, >= 2)
+#   --phold-remote R      PHOLD's probability of a message to another partition (default 0.1)
+#   --phold-lookahead L   PHOLD's minimum delay (default 0.1)
 #   --workers LIST        worker (and rank) counts, e.g. 1,2,4,8,12,16 (default: as above)
 #   --max-workers N       largest count of the default list (default: the cores available)
 #   --repeats N           runs of each configuration (default 3)
@@ -90,6 +93,7 @@ die() { echo "scaling.sh: $*" >&2; exit 2; }
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd) || die "cannot find the repository"
 
 balls=99856 until=0.5 phold_objects=16384 phold_end=10 phold_partitions=
+phold_remote=0.1 phold_lookahead=0.1
 workers_list= max_workers= repeats=3 models=gas,phold use_mpi=0 cpus= timeout_s=600
 build=1 binary= out=
 args_given=("$@")
@@ -108,6 +112,8 @@ while (($#)); do
     --phold-objects) phold_objects=$val ;;
     --phold-end) phold_end=$val ;;
     --phold-partitions) phold_partitions=$val ;;
+    --phold-remote) phold_remote=$val ;;
+    --phold-lookahead) phold_lookahead=$val ;;
     --workers) workers_list=$val ;;
     --max-workers) max_workers=$val ;;
     --repeats) repeats=$val ;;
@@ -275,7 +281,7 @@ EOF
   echo "# machine: $machine"
   echo "# binary: $bin ($version)${cpus:+, on CPUs $cpus}"
   echo "# command: scripts/scaling.sh ${args_given[*]:-}"
-  echo "# gas: $balls balls to t = $until, --sectors auto; phold: $phold_objects objects to t = $phold_end, $phold_partitions partitions; counts: ${counts[*]}; repeats: $repeats${mpi:+; mpi: ${mpi[*]}}"
+  echo "# gas: $balls balls to t = $until, --sectors auto; phold: $phold_objects objects to t = $phold_end, $phold_partitions partitions, remote $phold_remote, lookahead $phold_lookahead; counts: ${counts[*]}; repeats: $repeats${mpi:+; mpi: ${mpi[*]}}"
   printf '%s\t' model size until executor ranks workers cores repeat slot status process_s \
     wall_s setup_s events events_per_s batches efficiency final_share remote_fraction \
     gvt_rounds rollbacks peak_rss_mib digest
@@ -350,7 +356,8 @@ run_one() {
   else
     size=$phold_objects end=$phold_end
     cmd=("$bin" phold --objects "$phold_objects" --end "$phold_end" \
-         --partitions "$phold_partitions" "${engine[@]}" --json)
+         --partitions "$phold_partitions" --remote "$phold_remote" \
+         --lookahead "$phold_lookahead" "${engine[@]}" --json)
   fi
   [[ $executor == mpi ]] && cmd=("${mpi[@]}" -np "$ranks" "${cmd[@]}")
   local t0 t1 rc
