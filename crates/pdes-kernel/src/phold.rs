@@ -107,7 +107,8 @@ impl Phold {
         let (to, delay) = self.draw(me, &mut state.rng);
         state.sends += 1;
         let t = ctx.now().t() + delay;
-        ctx.send_at(to, VTime::at(PlainTime(t)), ());
+        // never cancelled: a relay, which Time Warp need not look up among cancellations
+        ctx.relay_at(to, VTime::at(PlainTime(t)), ());
     }
 }
 
@@ -132,6 +133,10 @@ impl Model for Phold {
 
     fn observed(&self, _: u32) -> bool {
         false
+    }
+
+    fn lookahead(&self) -> f64 {
+        self.cfg.lookahead
     }
 
     fn init(&self, ctx: &mut Ctx<'_, Phold>, me: u32, state: &mut PholdState) {
@@ -309,6 +314,41 @@ mod tests {
         let (model, _) = Phold::new(cfg(1, 0.9));
         assert!((0..1000).all(|_| model.partition(model.draw(3, &mut rng).0) == 0));
     }
+
+    /// A PHOLD that promises more lookahead than its delays keep.
+    struct Hasty(Phold);
+
+    impl Model for Hasty {
+        type Time = PlainTime;
+        type Msg = ();
+        type State = PholdState;
+        type Output = ();
+        type Undo = ();
+        fn kind_names(&self) -> &'static [&'static str] {
+            self.0.kind_names()
+        }
+        fn kind(&self, m: &()) -> usize {
+            self.0.kind(m)
+        }
+        fn priority(&self, m: &()) -> u8 {
+            self.0.priority(m)
+        }
+        fn lookahead(&self) -> f64 {
+            2.0
+        }
+        fn init(&self, ctx: &mut Ctx<'_, Hasty>, _: u32, _: &mut PholdState) {
+            let at = VTime::at(PlainTime(ctx.now().t() + 1.0));
+            ctx.relay_at(0, at, ());
+        }
+        fn handle(&self, _: &mut Ctx<'_, Hasty>, _: u32, _: &mut PholdState, _: &[Envelope<()>]) {}
+    }
+
+    #[test]
+    #[should_panic(expected = "sooner than the model's lookahead 2")]
+    fn a_send_sooner_than_the_lookahead_is_a_model_bug() {
+        let (model, states) = Phold::new(cfg(1, 0.0));
+        let _ = Sequential::new(Hasty(model), states, VTime::start(0.0));
+    }
 }
 
 #[cfg(test)]
@@ -329,9 +369,12 @@ mod time_warp_tests {
 
     #[test]
     fn time_warp_commits_the_sequential_run() {
-        for workers in [1usize, 2, 3] {
+        for (workers, lookahead) in [(1usize, 0.0), (2, 0.0), (3, 0.0), (2, 0.3), (3, 0.3)] {
             for chaos in [None, Some(7)] {
-                let c = cfg(workers as u32);
+                let c = PholdConfig {
+                    lookahead,
+                    ..cfg(workers as u32)
+                };
                 let (model, states) = Phold::new(c.clone());
                 let mut seq = Sequential::new(model, states, VTime::start(0.0));
                 seq.run::<()>(30.0, &mut |_, _, _| Ok(())).unwrap();
@@ -348,10 +391,16 @@ mod time_warp_tests {
                 let a: Vec<(u64, u64)> =
                     seq.states().iter().map(|s| (s.handled, s.sends)).collect();
                 let b: Vec<(u64, u64)> = tw.states().iter().map(|s| (s.handled, s.sends)).collect();
-                assert_eq!(a, b, "workers {workers} chaos {chaos:?}");
-                assert_eq!(seq.stats(), tw.stats(), "workers {workers} chaos {chaos:?}");
+                let what = format!("workers {workers} lookahead {lookahead} chaos {chaos:?}");
+                assert_eq!(a, b, "{what}");
+                assert_eq!(seq.stats(), tw.stats(), "{what}");
                 let st = tw.tw_stats();
                 assert_eq!(st.committed, seq.stats().batches);
+                if lookahead > 0.0 && chaos.is_none() {
+                    // the other workers' floors plus the lookahead cover most batches
+                    let share = st.final_batches as f64 / st.committed as f64;
+                    assert!(share > 0.5, "{what}: final share {share}");
+                }
                 eprintln!("workers {workers} chaos {chaos:?}: {st:?}");
             }
         }

@@ -165,25 +165,19 @@ pub struct Bounds {
     pub any: Floor,
     /// Below every message and anti-message, cancellations aside: a worker standing at a
     /// floor sends those only from the floor's next generation on
-    /// ([`Floor::next_generation`]), and ops waiting for the asking worker come where they are.
+    /// ([`Floor::next_generation`]), or from the model's lookahead past it
+    /// ([`Floor::later_by`]), and ops waiting for the asking worker come where they are.
     pub messages: Floor,
 }
 
 impl Bounds {
     /// The bounds of a worker whose peers' floors (their own and their inboxes') are at
-    /// least `others` and whose own inbox's floor is `mine`.
-    pub fn of_peers(others: Floor, mine: Floor) -> Bounds {
+    /// least `others` and whose own inbox's floor is `mine`, in a model whose messages come at
+    /// least `lookahead` after the batches that send them.
+    pub fn of_peers(others: Floor, mine: Floor, lookahead: f64) -> Bounds {
         Bounds {
             any: others.min(mine),
-            messages: others.next_generation().min(mine),
-        }
-    }
-
-    /// These bounds, lowered to `floor` where they are above it.
-    pub fn below(self, floor: Floor) -> Bounds {
-        Bounds {
-            any: self.any.min(floor),
-            messages: self.messages.min(floor),
+            messages: others.later_by(lookahead).min(mine),
         }
     }
 }
@@ -208,8 +202,9 @@ pub trait Fabric<M: Model>: Sync {
     fn publish(&self, _me: usize, _floor: Floor) {}
     /// Floors below what other workers may still send worker `me`, when the fabric can tell:
     /// the published floors and the ops waiting in inboxes of its process, read at one instant
-    /// (across ranks, with the bound the last complete round gave, read after them).
-    fn peers_floor(&self, _me: usize) -> Option<Bounds> {
+    /// (across ranks, with the bound the last complete round gave, read after them), in a
+    /// model whose messages come at least `lookahead` after the batches that send them.
+    fn peers_floor(&self, _me: usize, _lookahead: f64) -> Option<Bounds> {
         None
     }
     /// Whether worker `me`, with `done` GVT rounds behind it, starts a round now: when it is

@@ -116,6 +116,23 @@ impl Floor {
         }
     }
 
+    /// Below every message a worker standing at this floor may still send when every message
+    /// comes at least `lookahead` after the batch that sends it ([`Model::lookahead`](crate::Model::lookahead)): the
+    /// start of the instant `t + lookahead` (as `f64` addition rounds it), or the next
+    /// generation when that is no later.
+    pub fn later_by(self, lookahead: f64) -> Floor {
+        let next = self.next_generation();
+        if !(lookahead > 0.0 && self.t.is_finite()) {
+            return next;
+        }
+        let start = Floor::start(self.t + lookahead);
+        if start > next {
+            start
+        } else {
+            next
+        }
+    }
+
     /// The smaller of two floors.
     pub fn min(self, o: Floor) -> Floor {
         if o < self {
@@ -228,6 +245,20 @@ mod tests {
         assert!(!Floor::start(0.0).passed(&vtime(0.0, &[], 0), 0));
         assert!(Floor::INFINITY.passed(&vtime(1e300, &[], 0), 0));
         assert!(!Floor::NEG_INFINITY.passed(&vtime(-1e300, &[], 0), 0));
+    }
+
+    #[test]
+    fn a_lookahead_moves_the_floor_of_messages_to_the_start_of_a_later_instant() {
+        let f = Floor::of(&vtime(2.0, &[pair(1, 2)], 3), 7);
+        assert_eq!(f.later_by(0.0), f.next_generation());
+        assert_eq!(f.later_by(0.5), Floor::start(2.5));
+        // a message at exactly t + lookahead may come: nothing at that instant is passed
+        assert!(!f.later_by(0.5).passed(&vtime(2.5, &[], 0), 0));
+        assert!(f.later_by(0.5).passed(&vtime(2.4999, &[], 0), 0));
+        // a lookahead lost in rounding leaves the next generation
+        let big = Floor::start(1e20);
+        assert_eq!(big.later_by(1e-9), big.next_generation());
+        assert_eq!(Floor::INFINITY.later_by(1.0), Floor::INFINITY);
     }
 
     #[test]

@@ -240,7 +240,7 @@ where
         self.slots.publish(k, floor);
     }
 
-    fn peers_floor(&self, me: usize) -> Option<Bounds> {
+    fn peers_floor(&self, me: usize, lookahead: f64) -> Option<Bounds> {
         let k = self.local(me).expect("a worker of this rank");
         let (others, mine) = self.slots.peers(k)?;
         // read after the workers' floors: a parcel's op is under the far floor before its
@@ -249,7 +249,12 @@ where
             let f = self.far.lock().expect("no thread panicked");
             f.ranks.min(f.parcels)
         };
-        Some(Bounds::of_peers(others, mine).below(far))
+        // what the other ranks send comes from their floors, or from ops sent them, on
+        let peers = Bounds::of_peers(others, mine, lookahead);
+        Some(Bounds {
+            any: peers.any.min(far),
+            messages: peers.messages.min(far.later_by(lookahead)),
+        })
     }
 
     fn reduce(&self, me: usize, local: Reduction) -> Reduction {

@@ -284,9 +284,9 @@ where
         self.slots.publish(me, floor);
     }
 
-    fn peers_floor(&self, me: usize) -> Option<Bounds> {
+    fn peers_floor(&self, me: usize, lookahead: f64) -> Option<Bounds> {
         self.slots
             .peers(me)
-            .map(|(others, mine)| Bounds::of_peers(others, mine))
+            .map(|(others, mine)| Bounds::of_peers(others, mine, lookahead))
     }
 }

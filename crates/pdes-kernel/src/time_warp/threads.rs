@@ -529,8 +529,8 @@ mod tests {
         let (tx, _rx) = mpsc::channel();
         let f: ThreadFabric<Numbers> = ThreadFabric::new(3, tx);
         assert!(Fabric::shares_floors(&f));
-        let any = |me| f.peers_floor(me).map(|b| b.any);
-        let messages = |me| f.peers_floor(me).map(|b| b.messages);
+        let any = |me| f.peers_floor(me, 0.0).map(|b| b.any);
+        let messages = |me| f.peers_floor(me, 0.0).map(|b| b.messages);
         // a worker that has published nothing covers nothing
         assert_eq!(any(0), Some(Floor::NEG_INFINITY));
         f.publish(0, Floor::start(9.0));
@@ -597,7 +597,7 @@ mod tests {
         fn shares_floors(&self) -> bool {
             true
         }
-        fn peers_floor(&self, _: usize) -> Option<Bounds> {
+        fn peers_floor(&self, _: usize, _: f64) -> Option<Bounds> {
             Some(Bounds {
                 any: Floor::INFINITY,
                 messages: Floor::INFINITY,

@@ -346,6 +346,8 @@ pub struct Worker<M: Model> {
     published: Floor,
     /// Whether batches may run as final ([`TwConfig::final_batches`]).
     final_ok: bool,
+    /// The model's least delay of a message ([`Model::lookahead`]).
+    lookahead: f64,
     /// Whether the collector wants observed objects' states.
     ship: bool,
     /// Below every op another worker may still send here, as last found (lowered by every op
@@ -434,6 +436,7 @@ impl<M: Model> Worker<M> {
             log: Log::default(),
             published: Floor::NEG_INFINITY,
             final_ok: false,
+            lookahead: 0.0,
             ship: false,
             final_bound: Floor::NEG_INFINITY,
             message_bound: Floor::NEG_INFINITY,
@@ -748,7 +751,7 @@ impl<M: Model> Worker<M> {
             self.bound_wait -= 1;
             return None;
         }
-        if let Some(peers) = fabric.peers_floor(self.index) {
+        if let Some(peers) = fabric.peers_floor(self.index, self.lookahead) {
             let mut own = self.outbox_floor;
             if let Some(c) = &self.chaos {
                 for (_, op) in &c.held {
@@ -1405,6 +1408,7 @@ impl<M: Model> Worker<M> {
     ) -> Result<(), Stop> {
         let mut buf = Vec::new();
         let mut since = 0u32;
+        self.lookahead = model.lookahead();
         let (interval, ahead) = self.prepare(fabric, cfg, ship);
         let result = loop {
             self.iteration += 1;
