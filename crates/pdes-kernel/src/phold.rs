@@ -396,11 +396,6 @@ mod time_warp_tests {
                 assert_eq!(seq.stats(), tw.stats(), "{what}");
                 let st = tw.tw_stats();
                 assert_eq!(st.committed, seq.stats().batches);
-                if lookahead > 0.0 && chaos.is_none() {
-                    // the other workers' floors plus the lookahead cover most batches
-                    let share = st.final_batches as f64 / st.committed as f64;
-                    assert!(share > 0.5, "{what}: final share {share}");
-                }
                 eprintln!("workers {workers} chaos {chaos:?}: {st:?}");
             }
         }

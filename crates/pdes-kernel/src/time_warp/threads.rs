@@ -540,6 +540,9 @@ mod tests {
         // messages come a generation after the lowest floor at the earliest
         let next = Floor::start(5.0).next_generation();
         assert_eq!(messages(0), Some(next));
+        // or, in a model with a lookahead, at the lowest floor plus the lookahead
+        let ahead = f.peers_floor(0, 0.25).expect("floors");
+        assert_eq!((ahead.any, ahead.messages), (Floor::start(5.0), Floor::start(5.25)));
         assert!(next > Floor::start(5.0) && !next.passed(&at(5.0).next_gen(), 0));
         assert_eq!(
             any(1),
@@ -571,6 +574,14 @@ mod tests {
             Some(Floor::of(&at(4.0), 9)),
             "an op waiting for the asking worker bounds it where it is"
         );
+        // with a lookahead, it still does
+        let ahead = f.peers_floor(0, 0.5).expect("floors");
+        assert_eq!(ahead.messages, Floor::of(&at(4.0), 9));
+        // for another worker, the op waiting for worker 0 moves by the lookahead: worker 0
+        // sends from its time plus the lookahead on
+        let ahead = f.peers_floor(2, 0.5).expect("floors");
+        assert_eq!(ahead.any, Floor::of(&at(4.0), 9));
+        assert_eq!(ahead.messages, Floor::start(4.5));
     }
 
     /// The threads' fabric, but claiming that nothing can ever come: every batch runs final.
