@@ -199,6 +199,7 @@ fn a_tight_memory_budget_rolls_back_and_stays_exact() {
             // every batch saved, so that the budget binds
             final_batches: false,
             window: Some(0.05),
+            burst: None,
         },
         delay: NvDelay::Exact,
         sectors: Some(SectorChoice::Grid(4, 4)),

@@ -139,6 +139,14 @@ pub fn start_mpi() -> Result<Option<mpi::environment::Universe>, Failure> {
     }
 }
 
+/// `--tw-burst`, checked: at least one batch.
+pub fn burst(n: Option<u32>) -> Result<Option<u32>, Failure> {
+    match n {
+        Some(0) => Err(usage("--tw-burst: must be at least 1")),
+        n => Ok(n),
+    }
+}
+
 /// Time Warp's default settings with `--workers` (default: this machine's cores) and
 /// `POOLSIM_CHAOS`.
 pub fn tw_workers(workers: Option<usize>) -> Result<TwConfig, Failure> {

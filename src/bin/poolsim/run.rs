@@ -58,6 +58,10 @@ pub struct RunArgs {
     /// nothing can roll back any more (by default such a batch runs as final).
     #[arg(long = "tw-pure")]
     pub tw_pure: bool,
+    /// Batches a Time Warp worker runs between looks at its inbox (default 128; 64 with
+    /// --tw-pure).
+    #[arg(long = "tw-burst")]
+    pub tw_burst: Option<u32>,
     /// Delay of NewVelocity messages (objects engines): a time, or auto.
     #[arg(long = "newvelocity-delay")]
     pub newvelocity_delay: Option<Delay>,
@@ -98,6 +102,7 @@ impl RunArgs {
             tw_memory: None,
             gvt_interval: None,
             tw_pure: false,
+            tw_burst: None,
             newvelocity_delay,
             fixed_news: None,
             dt: None,
@@ -188,6 +193,7 @@ pub fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
         tw.gvt_interval = Some(g);
     }
     tw.final_batches = !a.tw_pure;
+    tw.burst = burst(a.tw_burst)?;
     Ok(tw)
 }
 
@@ -268,6 +274,7 @@ pub fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure
         ("--tw-memory", a.tw_memory.is_some()),
         ("--gvt-interval", a.gvt_interval.is_some()),
         ("--tw-pure", a.tw_pure),
+        ("--tw-burst", a.tw_burst.is_some()),
     ] {
         if given && !time_warp {
             return Err(usage(format!("{flag}: only the time-warp engine takes it")));

@@ -69,7 +69,8 @@ mod window;
 mod worker;
 
 pub use config::{
-    TwConfig, TwStats, ACROSS_RANKS_GVT_INTERVAL, MAX_CASCADE_DEPTH, THREADS_GVT_INTERVAL,
+    TwConfig, TwStats, ACROSS_RANKS_GVT_INTERVAL, DEFAULT_BURST, MAX_CASCADE_DEPTH, PURE_BURST,
+    THREADS_GVT_INTERVAL,
 };
 pub use fabric::{Bounds, Chunk, Committed, CommittedOf, Fabric, Op, OpOf, Reduction};
 pub use floor::Floor;

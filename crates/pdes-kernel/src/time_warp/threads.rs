@@ -542,7 +542,10 @@ mod tests {
         assert_eq!(messages(0), Some(next));
         // or, in a model with a lookahead, at the lowest floor plus the lookahead
         let ahead = f.peers_floor(0, 0.25).expect("floors");
-        assert_eq!((ahead.any, ahead.messages), (Floor::start(5.0), Floor::start(5.25)));
+        assert_eq!(
+            (ahead.any, ahead.messages),
+            (Floor::start(5.0), Floor::start(5.25))
+        );
         assert!(next > Floor::start(5.0) && !next.passed(&at(5.0).next_gen(), 0));
         assert_eq!(
             any(1),

@@ -1,7 +1,9 @@
 //! One worker: its objects, their pending messages and uncommitted batches; the loop that runs
 //! them optimistically, rolls back, commits and takes part in GVT rounds.
 
-use super::config::{TwConfig, TwStats, MAX_CASCADE_DEPTH, THREADS_GVT_INTERVAL};
+use super::config::{
+    TwConfig, TwStats, DEFAULT_BURST, MAX_CASCADE_DEPTH, PURE_BURST, THREADS_GVT_INTERVAL,
+};
 use super::fabric::*;
 use super::floor::Floor;
 use super::log::{Chain, Log};
@@ -348,6 +350,8 @@ pub struct Worker<M: Model> {
     final_ok: bool,
     /// The model's least delay of a message ([`Model::lookahead`]).
     lookahead: f64,
+    /// Batches in a burst ([`TwConfig::burst`], at most a GVT interval).
+    burst_len: u32,
     /// Whether the collector wants observed objects' states.
     ship: bool,
     /// Below every op another worker may still send here, as last found (lowered by every op
@@ -437,6 +441,7 @@ impl<M: Model> Worker<M> {
             published: Floor::NEG_INFINITY,
             final_ok: false,
             lookahead: 0.0,
+            burst_len: DEFAULT_BURST,
             ship: false,
             final_bound: Floor::NEG_INFINITY,
             message_bound: Floor::NEG_INFINITY,
@@ -1471,6 +1476,13 @@ impl<M: Model> Worker<M> {
             interval
         } as usize;
         self.ship = ship;
+        let burst = if cfg.final_batches {
+            DEFAULT_BURST
+        } else {
+            PURE_BURST
+        };
+        // a round comes no later than the interval asks
+        self.burst_len = cfg.burst.unwrap_or(burst).clamp(1, interval);
         self.workers_here = (self.placement.workers() / ranks).max(1) as u32;
         // this run's fabric knows nothing of this worker yet: its first flush publishes
         self.published = Floor::NEG_INFINITY;
@@ -1490,13 +1502,9 @@ impl<M: Model> Worker<M> {
         mut limit: f64,
         ahead: usize,
     ) -> (u32, bool) {
-        // short bursts publish floors often, so that the others' batches can run as final
-        // (8 against 4: 2 workers with a gas of 10^5 disks to t = 0.5 ran 4-5 % faster in 13
-        // of 18 pairs, with 59 % of the batches final against 60 %)
         let burst = match &mut self.chaos {
             Some(c) => c.rng.gen_range(1..64u32),
-            None if self.final_ok => 8,
-            None => 64,
+            None => self.burst_len,
         };
         let mut ran = 0;
         let mut held_back = false;
