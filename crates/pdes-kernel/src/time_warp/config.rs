@@ -42,10 +42,10 @@ pub struct TwConfig {
 }
 
 /// Batches a worker runs between looks at its inbox, with final batches on. Each look and each
-/// publication of the worker's floor moves cache lines between cores; PHOLD at 1,024 objects on
-/// 2 workers of the 2-core VM ran 1.3-1.6 times as fast with 128 as with 8 (remote 0.1 and 0.5,
-/// lookahead 0 and 0.1), 64 to 256 within noise of it, 1,024 slower (floors published too
-/// seldom for batches to run as final); the 10^5-disk gas was the same from 8 to 128.
+/// publication of the worker's floor moves cache lines between cores: PHOLD at 16,384 objects
+/// on 16 workers took 0.41 s with 128 against 0.55 s with 8 (0.48 s with 32, 0.43 s with 512);
+/// on 2 workers 128 and 8 are within a few per cent, and the 10^5-disk gas is the same with
+/// either.
 pub const DEFAULT_BURST: u32 = 128;
 /// Batches a worker runs between looks at its inbox when no batch runs as final.
 pub const PURE_BURST: u32 = 64;
