@@ -164,3 +164,61 @@ fn reverse_model_and_phold() {
     assert_eq!(p["committed"], again["committed"]);
     bad(&["phold", "--remote", "1.5"], "--remote");
 }
+
+#[test]
+fn phold_writes_one_line_of_statistics_per_gvt_round() {
+    let path = std::env::temp_dir().join(format!("poolsim-rounds-{}.jsonl", std::process::id()));
+    let p = path.to_str().unwrap();
+    let report = json(&poolsim(&[
+        "phold",
+        "--objects",
+        "128",
+        "--events-per-object",
+        "4",
+        "--end",
+        "20",
+        "--engine",
+        "time-warp",
+        "--workers",
+        "2",
+        "--stats",
+        p,
+        "--json",
+    ]));
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let rounds: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let tw = &report["time_warp"];
+    assert_eq!(rounds.len() as u64, tw["gvt_rounds"].as_u64().unwrap());
+    let mut last = (0.0, 0u64);
+    for (k, r) in rounds.iter().enumerate() {
+        assert_eq!(r["round"].as_u64(), Some(k as u64 + 1));
+        let workers = r["workers"].as_array().unwrap();
+        assert_eq!(workers.len(), 2);
+        // GVT and the counts only grow
+        let gvt = r["gvt"].as_f64().unwrap();
+        let committed: u64 = workers
+            .iter()
+            .map(|w| w["committed"].as_u64().unwrap())
+            .sum();
+        assert!(gvt >= last.0 && committed >= last.1, "{r}");
+        last = (gvt, committed);
+    }
+    // the last round passed the end, and every batch committed by then is counted
+    assert!(last.0 > 20.0);
+    assert_eq!(last.1, tw["committed"].as_u64().unwrap());
+    bad(&["phold", "--stats", p], "only the time-warp engine");
+    bad(
+        &[
+            "phold",
+            "--engine",
+            "time-warp",
+            "--stats",
+            "/nonexistent/dir/x.jsonl",
+        ],
+        "cannot create the round statistics file",
+    );
+}

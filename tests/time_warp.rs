@@ -200,6 +200,7 @@ fn a_tight_memory_budget_rolls_back_and_stays_exact() {
             final_batches: false,
             window: Some(0.05),
             burst: None,
+            record_rounds: false,
         },
         delay: NvDelay::Exact,
         sectors: Some(SectorChoice::Grid(4, 4)),

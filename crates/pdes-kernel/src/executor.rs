@@ -3,7 +3,7 @@
 
 use crate::sequential::{Sequential, Sink};
 use crate::time_warp::threads::TimeWarp;
-use crate::time_warp::TwStats;
+use crate::time_warp::{RoundRecord, TwStats};
 use crate::{MessageStats, Model};
 
 /// Why a run stopped early.
@@ -35,6 +35,12 @@ pub trait Executor<M: Model, E> {
     /// Time Warp's own statistics, where the executor is Time Warp.
     fn tw_stats(&self) -> Option<TwStats> {
         None
+    }
+
+    /// Time Warp's record of every GVT round, when it keeps one
+    /// ([`TwConfig::record_rounds`](crate::time_warp::TwConfig::record_rounds)).
+    fn round_records(&self) -> &[RoundRecord] {
+        &[]
     }
 
     /// Whether the sink reads the states just after each batch (the default); an executor that
@@ -98,6 +104,10 @@ where
 
     fn tw_stats(&self) -> Option<TwStats> {
         Some(TimeWarp::tw_stats(self))
+    }
+
+    fn round_records(&self) -> &[RoundRecord] {
+        TimeWarp::round_records(self)
     }
 
     fn observe_states(&mut self, on: bool) {

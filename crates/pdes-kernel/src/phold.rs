@@ -16,7 +16,7 @@
 use crate::digest::fnv_hex;
 use crate::sequential::Sequential;
 use crate::time_warp::threads::{total_workers, TimeWarp};
-use crate::time_warp::{TwConfig, TwStats};
+use crate::time_warp::{RoundRecord, TwConfig, TwStats};
 use crate::{Ctx, Envelope, ExecError, Executor, Model, PlainTime, VTime};
 use rand::{Rng, RngCore, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -194,6 +194,10 @@ pub struct PholdReport {
     pub final_state_digest: String,
     /// Time Warp's statistics, under Time Warp.
     pub time_warp: Option<TwStats>,
+    /// Time Warp's record of every GVT round, when [`TwConfig::record_rounds`] asked for it
+    /// (not part of the JSON report).
+    #[serde(skip)]
+    pub rounds: Vec<RoundRecord>,
 }
 
 /// Why a PHOLD run failed.
@@ -230,6 +234,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
     };
     ex.run(end, &mut { never })?;
     let (stats, finals, time_warp) = (ex.stats().clone(), ex.states().to_vec(), ex.tw_stats());
+    let rounds = ex.round_records().to_vec();
     ex.free();
     let wall = start.elapsed().as_secs_f64();
     let committed = stats.delivered;
@@ -256,6 +261,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
                 .flat_map(|s| [s.handled, s.sends, s.rng.clone().next_u64()]),
         ),
         time_warp,
+        rounds,
     })
 }
 

@@ -55,6 +55,11 @@ pub struct PholdArgs {
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// Time Warp: write one JSON line per GVT round to this file: the round, GVT, seconds
+    /// since the start, and each worker's committed, processed and rolled-back batches, final
+    /// batches, rollbacks and remote messages so far.
+    #[arg(long)]
+    pub stats: Option<std::path::PathBuf>,
 }
 
 /// The most PHOLD events in flight (objects times events per object): about a gigabyte.
@@ -100,6 +105,7 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
         PholdEngine::TimeWarp => Some(pdes_kernel::time_warp::TwConfig {
             final_batches: !a.tw_pure,
             burst: burst(a.tw_burst)?,
+            record_rounds: a.stats.is_some(),
             ..tw_workers(a.workers)?
         }),
     };
@@ -107,6 +113,7 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
         for (flag, given) in [
             ("--tw-pure", a.tw_pure),
             ("--tw-burst", a.tw_burst.is_some()),
+            ("--stats", a.stats.is_some()),
         ] {
             if given {
                 return Err(usage(format!("{flag}: only the time-warp engine takes it")));
@@ -145,6 +152,10 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
             ),
         }));
     }
+    let stats = match &a.stats {
+        Some(p) if pdes_kernel::time_warp::threads::collects_results() => Some(stats_file(p)?),
+        _ => None,
+    };
     let report = run(
         PholdConfig {
             objects: a.objects,
@@ -162,8 +173,41 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
     if pdes_kernel::time_warp::threads::place().0 != 0 {
         return Ok(());
     }
+    if let (Some(file), Some(p)) = (stats, &a.stats) {
+        write_rounds(file, &report.rounds).map_err(|e| {
+            usage(format!(
+                "{}: writing the round statistics failed: {e}",
+                p.display()
+            ))
+        })?;
+    }
     print_report(&report, a.json);
     Ok(())
+}
+
+/// The file of `--stats`, created before the run, so that a path that cannot be written fails
+/// at once.
+fn stats_file(p: &std::path::Path) -> Result<std::fs::File, Failure> {
+    std::fs::File::create(p).map_err(|e| {
+        usage(format!(
+            "{}: cannot create the round statistics file: {e}",
+            p.display()
+        ))
+    })
+}
+
+/// Writes one JSON line per GVT round.
+fn write_rounds(
+    file: std::fs::File,
+    rounds: &[pdes_kernel::time_warp::RoundRecord],
+) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::BufWriter::new(file);
+    for r in rounds {
+        serde_json::to_writer(&mut out, r)?;
+        out.write_all(b"\n")?;
+    }
+    out.flush()
 }
 
 /// Prints a PHOLD report as text, or as one JSON object.

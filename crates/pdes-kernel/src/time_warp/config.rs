@@ -39,6 +39,39 @@ pub struct TwConfig {
     /// `None` for [`DEFAULT_BURST`] (or [`PURE_BURST`] without final batches); never more than
     /// the GVT interval.
     pub burst: Option<u32>,
+    /// Whether the collector keeps a [`RoundRecord`] of every GVT round
+    /// ([`TimeWarp::round_records`](super::threads::TimeWarp::round_records)).
+    pub record_rounds: bool,
+}
+
+/// What every worker had done by the end of one GVT round (kept with
+/// [`TwConfig::record_rounds`]): statistics over time.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RoundRecord {
+    /// The round, from 1.
+    pub round: u64,
+    /// GVT's simulation time after it.
+    pub gvt: f64,
+    /// Seconds since the run started, as the slowest worker to reach the round saw it.
+    pub wall_s: f64,
+    /// Each worker's counts from the start of the run, in worker order.
+    pub workers: Vec<super::Progress>,
+}
+
+impl RoundRecord {
+    /// The record of round `round` from every worker's chunk of it.
+    pub fn of<T, S, O>(round: u64, chunks: &[super::Chunk<T, S, O>]) -> RoundRecord {
+        let mut workers: Vec<(usize, super::Progress)> =
+            chunks.iter().map(|c| (c.worker, c.progress)).collect();
+        workers.sort_by_key(|&(w, _)| w);
+        let workers: Vec<super::Progress> = workers.into_iter().map(|(_, p)| p).collect();
+        RoundRecord {
+            round,
+            gvt: workers.first().map_or(f64::NAN, |p| p.gvt),
+            wall_s: workers.iter().map(|p| p.wall_s).fold(0.0, f64::max),
+            workers,
+        }
+    }
 }
 
 /// Batches a worker runs between looks at its inbox, with final batches on. Each look and each
@@ -72,6 +105,7 @@ impl Default for TwConfig {
             max_uncommitted: 1 << 21,
             final_batches: true,
             burst: None,
+            record_rounds: false,
         }
     }
 }

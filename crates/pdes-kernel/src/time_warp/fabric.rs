@@ -156,6 +156,30 @@ pub struct Chunk<T, S, O> {
     pub finals: Vec<(u32, S)>,
     /// Set when the worker stopped on an error.
     pub error: Option<String>,
+    /// Where the worker stood after this round.
+    pub progress: Progress,
+}
+
+/// One worker's counts after a GVT round, from the start of the run: what
+/// [`RoundRecord`](super::RoundRecord)s keep.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Progress {
+    /// GVT's simulation time after the round.
+    pub gvt: f64,
+    /// Seconds since the worker started the run.
+    pub wall_s: f64,
+    /// Batches committed.
+    pub committed: u64,
+    /// Batches run, rolled-back ones included.
+    pub processed: u64,
+    /// Batches undone.
+    pub rolled_back: u64,
+    /// Batches run as final.
+    pub final_batches: u64,
+    /// Rollbacks.
+    pub rollbacks: u64,
+    /// Remote messages sent.
+    pub remote_messages: u64,
 }
 
 /// What other workers may still send one worker, as [`Fabric::peers_floor`] reads it.

@@ -69,9 +69,9 @@ mod window;
 mod worker;
 
 pub use config::{
-    TwConfig, TwStats, ACROSS_RANKS_GVT_INTERVAL, DEFAULT_BURST, MAX_CASCADE_DEPTH, PURE_BURST,
-    THREADS_GVT_INTERVAL,
+    RoundRecord, TwConfig, TwStats, ACROSS_RANKS_GVT_INTERVAL, DEFAULT_BURST, MAX_CASCADE_DEPTH,
+    PURE_BURST, THREADS_GVT_INTERVAL,
 };
-pub use fabric::{Bounds, Chunk, Committed, CommittedOf, Fabric, Op, OpOf, Reduction};
+pub use fabric::{Bounds, Chunk, Committed, CommittedOf, Fabric, Op, OpOf, Progress, Reduction};
 pub use floor::Floor;
 pub use worker::{Placement, Stop, Worker};

@@ -3,7 +3,7 @@
 //! the sink.
 
 use super::thread_fabric::ThreadFabric;
-use super::{Chunk, CommittedOf, Fabric, Op, Placement, TwConfig, TwStats, Worker};
+use super::{Chunk, CommittedOf, Fabric, Op, Placement, RoundRecord, TwConfig, TwStats, Worker};
 use crate::executor::ExecError;
 use crate::sequential::Sink;
 use crate::{MessageStats, Model, VTime};
@@ -50,6 +50,10 @@ pub struct Collector<M: Model> {
     pub messages: MessageStats,
     /// Live messages left at the end.
     pub pending: u64,
+    /// Whether to keep a record of every round ([`TwConfig::record_rounds`]).
+    pub record: bool,
+    /// The records of the rounds so far.
+    pub records: Vec<RoundRecord>,
 }
 
 impl<M: Model> Collector<M> {
@@ -65,6 +69,8 @@ impl<M: Model> Collector<M> {
             stats: TwStats::default(),
             messages: MessageStats::default(),
             pending: 0,
+            record: false,
+            records: Vec::new(),
         }
     }
 
@@ -97,6 +103,9 @@ impl<M: Model> Collector<M> {
             .is_some_and(|v| v.len() == workers)
         {
             let chunks = self.rounds.remove(&self.next_round).expect("a round");
+            if self.record {
+                self.records.push(RoundRecord::of(self.next_round, &chunks));
+            }
             self.next_round += 1;
             if failed.is_some() {
                 continue;
@@ -249,11 +258,13 @@ where
         for (w, ops) in workers.iter_mut().zip(mail) {
             w.accept(ops);
         }
+        let mut collector = Collector::new(states);
+        collector.record = cfg.record_rounds;
         TimeWarp {
             model,
             workers,
             cfg,
-            collector: Collector::new(states),
+            collector,
             ranks,
             handed_over: false,
         }
@@ -296,6 +307,12 @@ where
     /// MPI).
     pub fn pending_len(&self) -> usize {
         self.collector.pending as usize
+    }
+
+    /// A record of every GVT round of the runs so far, with [`TwConfig::record_rounds`] (on
+    /// rank 0 under MPI; empty without).
+    pub fn round_records(&self) -> &[RoundRecord] {
+        &self.collector.records
     }
 
     /// Every worker's memory samples (uncommitted batches plus held messages) per GVT round.
@@ -463,6 +480,7 @@ mod tests {
             last: None,
             finals: Vec::new(),
             error: None,
+            progress: Default::default(),
         }
     }
 

@@ -350,6 +350,8 @@ pub struct Worker<M: Model> {
     final_ok: bool,
     /// The model's least delay of a message ([`Model::lookahead`]).
     lookahead: f64,
+    /// When the worker started its latest run.
+    started: Option<std::time::Instant>,
     /// Batches in a burst ([`TwConfig::burst`], at most a GVT interval).
     burst_len: u32,
     /// Whether the collector wants observed objects' states.
@@ -441,6 +443,7 @@ impl<M: Model> Worker<M> {
             published: Floor::NEG_INFINITY,
             final_ok: false,
             lookahead: 0.0,
+            started: None,
             burst_len: DEFAULT_BURST,
             ship: false,
             final_bound: Floor::NEG_INFINITY,
@@ -1414,6 +1417,7 @@ impl<M: Model> Worker<M> {
         let mut buf = Vec::new();
         let mut since = 0u32;
         self.lookahead = model.lookahead();
+        self.started = Some(std::time::Instant::now());
         let (interval, ahead) = self.prepare(fabric, cfg, ship);
         let result = loop {
             self.iteration += 1;
@@ -1565,7 +1569,23 @@ impl<M: Model> Worker<M> {
             last: None,
             finals: Vec::new(),
             error: None,
+            progress: self.progress(),
         });
+    }
+
+    /// The worker's counts so far, for the collector's records of rounds.
+    fn progress(&self) -> Progress {
+        let s = &self.stats;
+        Progress {
+            gvt: self.gvt.t,
+            wall_s: self.started.map_or(0.0, |t| t.elapsed().as_secs_f64()),
+            committed: s.committed,
+            processed: s.processed,
+            rolled_back: s.rolled_back,
+            final_batches: s.final_batches,
+            rollbacks: s.rollbacks,
+            remote_messages: s.remote_messages,
+        }
     }
 
     /// The worker's last word to the collector: its statistics, the error that stopped it,
@@ -1598,6 +1618,7 @@ impl<M: Model> Worker<M> {
             )),
             finals,
             error,
+            progress: self.progress(),
         });
     }
 }
