@@ -518,6 +518,10 @@ fn measure_phold(
                 sequential: first.final_state_digest.clone(),
             });
         }
+        let p = match phold.first() {
+            Some(sequential) => p.against(sequential),
+            None => p,
+        };
         each(Measured::Phold(&p));
         phold.push(p);
     }

@@ -183,8 +183,13 @@ fn phold_writes_one_line_of_statistics_per_gvt_round() {
         "2",
         "--stats",
         p,
+        "--baseline",
         "--json",
     ]));
+    // the sequential baseline of the same invocation
+    let seq = report["sequential_wall_seconds"].as_f64().unwrap();
+    let x = report["speedup"].as_f64().unwrap();
+    assert!((x - seq / report["wall_seconds"].as_f64().unwrap()).abs() < 1e-9);
     let text = std::fs::read_to_string(&path).unwrap();
     std::fs::remove_file(&path).unwrap();
     let rounds: Vec<serde_json::Value> = text
@@ -211,6 +216,7 @@ fn phold_writes_one_line_of_statistics_per_gvt_round() {
     assert!(last.0 > 20.0);
     assert_eq!(last.1, tw["committed"].as_u64().unwrap());
     bad(&["phold", "--stats", p], "only the time-warp engine");
+    bad(&["phold", "--baseline"], "only the time-warp engine");
     bad(
         &[
             "phold",

@@ -194,10 +194,25 @@ pub struct PholdReport {
     pub final_state_digest: String,
     /// Time Warp's statistics, under Time Warp.
     pub time_warp: Option<TwStats>,
+    /// Seconds the sequential kernel took for the same model in the same invocation, when the
+    /// caller ran it as a baseline ([`PholdReport::against`]).
+    pub sequential_wall_seconds: Option<f64>,
+    /// The sequential kernel's time over this run's: the speed-up of a parallel run.
+    pub speedup: Option<f64>,
     /// Time Warp's record of every GVT round, when [`TwConfig::record_rounds`] asked for it
     /// (not part of the JSON report).
     #[serde(skip)]
     pub rounds: Vec<RoundRecord>,
+}
+
+impl PholdReport {
+    /// This report with its speed-up over `sequential`, a run of the same model on the
+    /// sequential kernel.
+    pub fn against(mut self, sequential: &PholdReport) -> PholdReport {
+        self.sequential_wall_seconds = Some(sequential.wall_seconds);
+        self.speedup = Some(sequential.wall_seconds / self.wall_seconds.max(1e-9));
+        self
+    }
 }
 
 /// Why a PHOLD run failed.
@@ -261,6 +276,8 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
                 .flat_map(|s| [s.handled, s.sends, s.rng.clone().next_u64()]),
         ),
         time_warp,
+        sequential_wall_seconds: None,
+        speedup: None,
         rounds,
     })
 }

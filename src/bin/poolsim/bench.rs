@@ -290,7 +290,7 @@ fn phold_row(p: &PholdReport) {
     };
     println!(
         "PHOLD {} objects x 16 events, remote 0.1, {} partitions, end 20, {} ({}): {} \
-         committed, {:.0} events/s, {:.2} M per core, efficiency {:.3}, digest {}",
+         committed, {:.0} events/s, {:.2} M per core, efficiency {:.3}, {}digest {}",
         p.objects,
         p.partitions,
         p.engine,
@@ -299,6 +299,9 @@ fn phold_row(p: &PholdReport) {
         p.events_per_second,
         p.events_per_second_per_core / 1e6,
         p.time_warp.as_ref().map_or(1.0, |t| t.efficiency()),
+        p.speedup.map_or(String::new(), |s| format!(
+            "{s:.2}x the sequential kernel, "
+        )),
         p.final_state_digest
     );
 }

@@ -60,6 +60,10 @@ pub struct PholdArgs {
     /// batches, rollbacks and remote messages so far.
     #[arg(long)]
     pub stats: Option<std::path::PathBuf>,
+    /// Time Warp: run the same model on the sequential kernel first (rank 0 alone under MPI)
+    /// and report the speed-up over it.
+    #[arg(long)]
+    pub baseline: bool,
 }
 
 /// The most PHOLD events in flight (objects times events per object): about a gigabyte.
@@ -93,33 +97,9 @@ fn check_values(a: &PholdArgs) -> Result<(), Failure> {
 
 /// Runs `poolsim phold` and prints its report (on rank 0 under MPI).
 pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
-    use pdes_kernel::phold::{run, PholdConfig};
+    use pdes_kernel::phold::run;
     check_values(a)?;
-    let tw = match a.engine {
-        PholdEngine::Objects => {
-            if a.workers.is_some() {
-                return Err(usage("--workers: only the time-warp engine takes it"));
-            }
-            None
-        }
-        PholdEngine::TimeWarp => Some(pdes_kernel::time_warp::TwConfig {
-            final_batches: !a.tw_pure,
-            burst: burst(a.tw_burst)?,
-            record_rounds: a.stats.is_some(),
-            ..tw_workers(a.workers)?
-        }),
-    };
-    if tw.is_none() {
-        for (flag, given) in [
-            ("--tw-pure", a.tw_pure),
-            ("--tw-burst", a.tw_burst.is_some()),
-            ("--stats", a.stats.is_some()),
-        ] {
-            if given {
-                return Err(usage(format!("{flag}: only the time-warp engine takes it")));
-            }
-        }
-    }
+    let tw = tw_config(a)?;
     if tw.is_some() {
         poolsim::memory::transparent_huge_pages(false);
     }
@@ -129,6 +109,65 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
         Some(c) => pdes_kernel::time_warp::threads::total_workers(c) as u32,
         None => 2,
     });
+    check_sizes(a, partitions)?;
+    let stats = match &a.stats {
+        Some(p) if pdes_kernel::time_warp::threads::collects_results() => Some(stats_file(p)?),
+        _ => None,
+    };
+    let cfg = config(a, partitions);
+    let rank = pdes_kernel::time_warp::threads::place().0;
+    // rank 0 runs the baseline alone; the other ranks wait for it in Time Warp's first round
+    let baseline = if a.baseline && rank == 0 {
+        Some(run(cfg.clone(), a.end, None).map_err(|e| internal(e.to_string()))?)
+    } else {
+        None
+    };
+    let mut report = run(cfg, a.end, tw).map_err(|e| internal(e.to_string()))?;
+    if rank != 0 {
+        return Ok(());
+    }
+    if let Some(b) = &baseline {
+        report = report.against(b);
+    }
+    if let (Some(file), Some(p)) = (stats, &a.stats) {
+        write_rounds(file, &report.rounds).map_err(|e| {
+            usage(format!(
+                "{}: writing the round statistics failed: {e}",
+                p.display()
+            ))
+        })?;
+    }
+    print_report(&report, a.json);
+    Ok(())
+}
+
+/// Time Warp's settings from the flags, or `None` for the sequential kernel (which takes no
+/// Time Warp flag).
+fn tw_config(a: &PholdArgs) -> Result<Option<pdes_kernel::time_warp::TwConfig>, Failure> {
+    if a.engine == PholdEngine::TimeWarp {
+        return Ok(Some(pdes_kernel::time_warp::TwConfig {
+            final_batches: !a.tw_pure,
+            burst: burst(a.tw_burst)?,
+            record_rounds: a.stats.is_some(),
+            ..tw_workers(a.workers)?
+        }));
+    }
+    for (flag, given) in [
+        ("--workers", a.workers.is_some()),
+        ("--tw-pure", a.tw_pure),
+        ("--tw-burst", a.tw_burst.is_some()),
+        ("--stats", a.stats.is_some()),
+        ("--baseline", a.baseline),
+    ] {
+        if given {
+            return Err(usage(format!("{flag}: only the time-warp engine takes it")));
+        }
+    }
+    Ok(None)
+}
+
+/// Refuses object, event and partition counts PHOLD cannot run with.
+fn check_sizes(a: &PholdArgs, partitions: u32) -> Result<(), Failure> {
     if u64::from(a.objects) * u64::from(a.events_per_object) > MAX_PHOLD_EVENTS {
         return Err(usage(format!(
             "--objects x --events-per-object: at most {MAX_PHOLD_EVENTS} events in flight, got \
@@ -152,37 +191,20 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
             ),
         }));
     }
-    let stats = match &a.stats {
-        Some(p) if pdes_kernel::time_warp::threads::collects_results() => Some(stats_file(p)?),
-        _ => None,
-    };
-    let report = run(
-        PholdConfig {
-            objects: a.objects,
-            events_per_object: a.events_per_object,
-            remote: a.remote,
-            partitions,
-            lookahead: a.lookahead,
-            mean: a.mean,
-            seed: a.seed,
-        },
-        a.end,
-        tw,
-    )
-    .map_err(|e| internal(e.to_string()))?;
-    if pdes_kernel::time_warp::threads::place().0 != 0 {
-        return Ok(());
-    }
-    if let (Some(file), Some(p)) = (stats, &a.stats) {
-        write_rounds(file, &report.rounds).map_err(|e| {
-            usage(format!(
-                "{}: writing the round statistics failed: {e}",
-                p.display()
-            ))
-        })?;
-    }
-    print_report(&report, a.json);
     Ok(())
+}
+
+/// The model the flags describe.
+fn config(a: &PholdArgs, partitions: u32) -> pdes_kernel::phold::PholdConfig {
+    pdes_kernel::phold::PholdConfig {
+        objects: a.objects,
+        events_per_object: a.events_per_object,
+        remote: a.remote,
+        partitions,
+        lookahead: a.lookahead,
+        mean: a.mean,
+        seed: a.seed,
+    }
 }
 
 /// The file of `--stats`, created before the run, so that a path that cannot be written fails
@@ -246,6 +268,12 @@ fn print_report(report: &pdes_kernel::phold::PholdReport, json: bool) {
                 t.efficiency(),
                 t.rollbacks,
                 t.gvt_rounds
+            );
+        }
+        if let (Some(x), Some(seq)) = (report.speedup, report.sequential_wall_seconds) {
+            println!(
+                "speed-up: {x:.2}x the sequential kernel, which took {seq:.3} s for the same \
+                 model in this invocation"
             );
         }
     }
