@@ -50,10 +50,8 @@ pub struct Collector<M: Model> {
     pub messages: MessageStats,
     /// Live messages left at the end.
     pub pending: u64,
-    /// Whether to keep a record of every round ([`TwConfig::record_rounds`]).
-    pub record: bool,
-    /// The records of the rounds so far.
-    pub records: Vec<RoundRecord>,
+    /// The records of the rounds so far, when it keeps them ([`TwConfig::record_rounds`]).
+    pub records: Option<Vec<RoundRecord>>,
 }
 
 impl<M: Model> Collector<M> {
@@ -69,8 +67,7 @@ impl<M: Model> Collector<M> {
             stats: TwStats::default(),
             messages: MessageStats::default(),
             pending: 0,
-            record: false,
-            records: Vec::new(),
+            records: None,
         }
     }
 
@@ -103,8 +100,8 @@ impl<M: Model> Collector<M> {
             .is_some_and(|v| v.len() == workers)
         {
             let chunks = self.rounds.remove(&self.next_round).expect("a round");
-            if self.record {
-                self.records.push(RoundRecord::of(self.next_round, &chunks));
+            if let Some(records) = &mut self.records {
+                records.push(RoundRecord::of(self.next_round, &chunks));
             }
             self.next_round += 1;
             if failed.is_some() {
@@ -259,7 +256,7 @@ where
             w.accept(ops);
         }
         let mut collector = Collector::new(states);
-        collector.record = cfg.record_rounds;
+        collector.records = cfg.record_rounds.then(Vec::new);
         TimeWarp {
             model,
             workers,
@@ -312,7 +309,7 @@ where
     /// A record of every GVT round of the runs so far, with [`TwConfig::record_rounds`] (on
     /// rank 0 under MPI; empty without).
     pub fn round_records(&self) -> &[RoundRecord] {
-        &self.collector.records
+        self.collector.records.as_deref().unwrap_or(&[])
     }
 
     /// Every worker's memory samples (uncommitted batches plus held messages) per GVT round.

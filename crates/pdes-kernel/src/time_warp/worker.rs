@@ -340,9 +340,8 @@ pub struct Worker<M: Model> {
     fault: Option<String>,
     /// Local objects with uncommitted batches (fossil collection visits only these).
     active: Vec<u32>,
-    /// Uncommitted batches in the order they ran (committed early from the front), each
-    /// record boxed: the log's slots stay small, and a commit moves a pointer, not the record
-    /// (moved out of the log and into the commit, a record was copied three times).
+    /// Uncommitted batches in the order they ran (committed early from the front), held in
+    /// the log itself: a box per record cost an allocation and a free per undoable batch.
     log: Log<Done<M>>,
     /// The floor this worker published last (with final batches only).
     published: Floor,
