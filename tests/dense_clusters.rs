@@ -2,13 +2,14 @@
 //! a big table, tiny balls packed close). Every engine runs them; the exact ones end exactly as
 //! the event list does, event for event, and the time-step engine runs them to the end.
 
-use pdes_kernel::time_warp::TwConfig;
 use poolsim::geometry::Vec2;
 use poolsim::model::pool::NvDelay;
-use poolsim::output::{TraceLine, TraceRecorder};
-use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
+use poolsim::output::TraceLine;
+use poolsim::run::{EngineKind, FixedNews, SectorChoice};
 use poolsim::scenario::{BallSpec, CushionSpec, Scenario};
 use rand::{Rng, SeedableRng};
+
+mod common;
 
 /// Balls at `centres` with radius `radius` and random velocities of up to `speed` per axis, in a
 /// box of four elastic cushions from the origin to `(w, h)`.
@@ -101,28 +102,13 @@ fn grains_and_a_boulder(side: f64) -> Scenario {
 }
 
 fn run(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>, String) {
-    let mut rec = TraceRecorder::default();
-    let cfg = RunConfig {
-        engine,
-        until: s.until,
-        check,
-        span: Default::default(),
-    };
-    let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
-    (rec.lines, report.summary.final_state_digest)
+    let (trace, summary) = common::traced(s, engine, check);
+    (trace, summary.final_state_digest)
 }
 
 /// The objects engines: plain, sectored, and both under Time Warp on two workers.
 fn objects_engines() -> Vec<EngineKind> {
-    let tw = |sectors| EngineKind::TimeWarp {
-        tw: TwConfig {
-            workers: 2,
-            ..TwConfig::default()
-        },
-        delay: NvDelay::Exact,
-        sectors,
-        news: FixedNews::default(),
-    };
+    let tw = common::two_workers;
     vec![
         EngineKind::Objects {
             delay: NvDelay::Exact,

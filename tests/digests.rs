@@ -3,12 +3,13 @@
 //! recorded with the `poolsim` command; a change that alters any entry changes the physics or the
 //! message flow, and must say so.
 
-use pdes_kernel::time_warp::TwConfig;
 use poolsim::engine::Ignore;
 use poolsim::model::pool::NvDelay;
 use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
 use poolsim::scenario::{builtin, load, Scenario};
 use poolsim::summary::MessageKind;
+
+mod common;
 
 /// (scenario, engine, digest, events by kind: ball-ball ball-cushion ball-corner ball-pocket,
 /// messages by type in `MessageKind::ALL` order, then the thesis' total).
@@ -739,15 +740,7 @@ fn scenario(name: &str) -> Scenario {
 /// scenario's own sectors when it has them.
 fn engine(name: &str, s: &Scenario) -> EngineKind {
     let own = s.sectors.as_ref().map(|_| SectorChoice::Scenario);
-    let tw = |sectors| EngineKind::TimeWarp {
-        tw: TwConfig {
-            workers: 2,
-            ..TwConfig::default()
-        },
-        delay: NvDelay::Exact,
-        sectors,
-        news: FixedNews::default(),
-    };
+    let tw = common::two_workers;
     match name {
         "event-list" => EngineKind::EventList,
         "time-step" => EngineKind::TimeStep { dt: 0.001 },

@@ -3,7 +3,7 @@
 //! same state, bit for bit, on every built-in, every hard case and random tables.
 
 use poolsim::model::pool::NvDelay;
-use poolsim::output::{TraceLine, TraceRecorder};
+use poolsim::output::TraceLine;
 use poolsim::run::{execute, EngineKind, RunConfig};
 use poolsim::scenario::{builtin, load, Scenario};
 use proptest::prelude::*;
@@ -11,15 +11,8 @@ use proptest::prelude::*;
 mod common;
 
 fn run(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>, serde_json::Value) {
-    let mut rec = TraceRecorder::default();
-    let cfg = RunConfig {
-        engine,
-        until: s.until,
-        check,
-        span: Default::default(),
-    };
-    let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
-    (rec.lines, serde_json::to_value(&report.summary).unwrap())
+    let (trace, summary) = common::traced(s, engine, check);
+    (trace, serde_json::to_value(&summary).unwrap())
 }
 
 fn assert_same(s: &Scenario) {

@@ -1,8 +1,43 @@
-//! Shared test helpers: random tables for property tests.
+//! Shared test helpers: random tables for property tests, a traced run, Time Warp on two
+//! workers.
 
+// each test crate that includes this module uses a part of it
+#![allow(dead_code)]
+
+use pdes_kernel::time_warp::TwConfig;
 use poolsim::geometry::Vec2;
+use poolsim::model::pool::NvDelay;
+use poolsim::output::{TraceLine, TraceRecorder};
+use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
 use poolsim::scenario::{BallSpec, CushionSpec, PocketSpec, Scenario};
+use poolsim::summary::RunSummary;
 use proptest::prelude::*;
+
+/// Runs `s` to its end on `engine` (checking invariants with `check`): its trace and summary.
+pub fn traced(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>, RunSummary) {
+    let mut rec = TraceRecorder::default();
+    let cfg = RunConfig {
+        engine,
+        until: s.until,
+        check,
+        span: Default::default(),
+    };
+    let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
+    (rec.lines, report.summary)
+}
+
+/// Time Warp on two workers with the given sectors, exact NewVelocity delays.
+pub fn two_workers(sectors: Option<SectorChoice>) -> EngineKind {
+    EngineKind::TimeWarp {
+        tw: TwConfig {
+            workers: 2,
+            ..TwConfig::default()
+        },
+        delay: NvDelay::Exact,
+        sectors,
+        news: FixedNews::default(),
+    }
+}
 
 /// A random table: a box with random elasticities, sometimes a pocket in the top side, and balls
 /// of random sizes and masses, some placed touching others.
