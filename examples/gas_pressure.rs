@@ -59,6 +59,7 @@ fn main() {
             until: settle,
             check: false,
             span: Default::default(),
+            interrupt: None,
         },
         &mut Ignore,
     )
@@ -75,6 +76,7 @@ fn main() {
         until,
         check: true,
         span: Default::default(),
+        interrupt: None,
     };
     let report = execute(&settled, &cfg, &mut walls).expect("the gas runs");
 

@@ -41,6 +41,7 @@ fn main() {
             until: table.until,
             check: true,
             span: Default::default(),
+            interrupt: None,
         };
         let mut pockets = Pockets::default();
         let report = execute(&table, &cfg, &mut pockets).expect("the shot runs");

@@ -654,6 +654,7 @@ pub fn measure_time_warp(
             until,
             check: false,
             span: Default::default(),
+            interrupt: None,
         };
         let report = execute(&scenario, &cfg, &mut Ignore)?;
         let s = &report.summary;

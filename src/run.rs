@@ -19,8 +19,11 @@ use crate::physics::kinetic_energy;
 use crate::polygon::{LayoutError, Polygon, PolygonError};
 use crate::scenario::Scenario;
 use crate::scenario::SectorSpec;
-use crate::summary::{EventTotals, KineticEnergy, MessageCounts, RunSummary, TimeWarpSummary};
+use crate::summary::{
+    EventTotals, Interruption, KineticEnergy, MessageCounts, RunSummary, TimeWarpSummary,
+};
 use pdes_kernel::time_warp::TwConfig;
+use pdes_kernel::Interrupt;
 use std::time::Instant;
 
 /// Which engine runs.
@@ -137,6 +140,10 @@ pub struct RunConfig {
     pub check: bool,
     /// Start time and reversal.
     pub span: Span,
+    /// Ends the run early and cleanly once raised (a signal handler raises it with the
+    /// signal's number): the run stops at a time of the engine's choosing, every event up to
+    /// it reported, and its report says so.
+    pub interrupt: Option<Interrupt>,
 }
 
 /// What a run produced.
@@ -297,6 +304,9 @@ pub fn execute(
         .then(|| Checker::new(&initial, table.is_elastic()));
     let mut sinks = Sinks { checker, user: obs };
     let mut engine = build_engine(scenario, cfg)?;
+    if let Some(i) = &cfg.interrupt {
+        engine.stop_on(i.clone());
+    }
     // the engine built and its objects set up, before the first event
     let setup = start.elapsed().as_secs_f64();
     let outcome = engine.run(cfg.until, &mut sinks)?;
@@ -337,6 +347,11 @@ pub fn execute(
         checked: cfg.check,
         engine_stats,
         time_warp: time_warp.map(|tw| TimeWarpSummary::new(tw, crate::bench::peak_rss_mib())),
+        interrupted: cfg
+            .interrupt
+            .as_ref()
+            .and_then(Interrupt::cause)
+            .map(|cause| Interruption::new(outcome.t, cause)),
     };
     Ok(Report {
         outcome,
@@ -401,6 +416,7 @@ pub fn reverse(
             reverse_at: Some(0.0),
             frame_time: None,
         },
+        interrupt: None,
     };
     let mut forward = Forward(0);
     let report = execute(scenario, &cfg, &mut forward)?;

@@ -39,6 +39,31 @@ pub struct RunSummary {
     /// Time Warp's statistics, under Time Warp.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_warp: Option<TimeWarpSummary>,
+    /// Where and why the run stopped before `until`, when it was interrupted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interrupted: Option<Interruption>,
+}
+
+/// An interrupted run: the time it stopped at, every event up to it done, and the cause.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Interruption {
+    /// The time the run stopped at (the final state's time).
+    pub at: f64,
+    /// The signal's name (`SIGINT`, `SIGTERM`, `SIGHUP`), or `signal N` for another number.
+    pub signal: String,
+}
+
+impl Interruption {
+    /// A run stopped at `at` by signal number `signal`.
+    pub fn new(at: f64, signal: usize) -> Interruption {
+        let name = match i32::try_from(signal) {
+            Ok(libc::SIGINT) => "SIGINT".to_string(),
+            Ok(libc::SIGTERM) => "SIGTERM".to_string(),
+            Ok(libc::SIGHUP) => "SIGHUP".to_string(),
+            _ => format!("signal {signal}"),
+        };
+        Interruption { at, signal: name }
+    }
 }
 
 /// Physical events by trace kind.

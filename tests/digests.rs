@@ -773,6 +773,7 @@ fn every_scenario_on_every_engine_ends_as_recorded() {
             until: s.until,
             check: false,
             span: Default::default(),
+            interrupt: None,
         };
         let report = execute(&s, &cfg, &mut Ignore)
             .unwrap_or_else(|e| panic!("{name} on {engine_name}: {e}"));

@@ -117,6 +117,7 @@ fn engine_run(s: &Scenario, check: bool) -> (Vec<TraceLine>, Vec<BallState>) {
         until: s.until,
         check,
         span: Default::default(),
+        interrupt: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.outcome.balls)

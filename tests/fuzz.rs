@@ -164,6 +164,7 @@ fn digest(s: &Scenario, engine: EngineKind, check: bool) -> Result<String, RunEr
         until: s.until.min(3.0),
         check,
         span: Default::default(),
+        interrupt: None,
     };
     execute(s, &cfg, &mut Ignore).map(|r| r.summary.final_state_digest)
 }

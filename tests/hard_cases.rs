@@ -21,6 +21,7 @@ fn run(s: &Scenario) -> (Vec<TraceLine>, Vec<BallState>) {
         until: s.until,
         check: true,
         span: Default::default(),
+        interrupt: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.outcome.balls)

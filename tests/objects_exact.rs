@@ -100,6 +100,7 @@ fn delay_mode_loses_an_update_as_in_table_2() {
         until: s.until,
         check: false,
         span: Default::default(),
+        interrupt: None,
     };
     let report = execute(&s, &cfg, &mut poolsim::engine::Ignore).unwrap();
     let v: Vec<f64> = report
@@ -119,6 +120,7 @@ fn delay_mode_loses_an_update_as_in_table_2() {
     let cfg = RunConfig {
         engine: exact,
         ..cfg
+        interrupt: None,
     };
     let report = execute(&s, &cfg, &mut poolsim::engine::Ignore).unwrap();
     let v: Vec<f64> = report
@@ -217,6 +219,7 @@ fn projector_frames_match_the_event_list() {
                 until: s.until,
                 check: true,
                 span,
+                interrupt: None,
             };
             let mut frames = Frames::default();
             let report = execute(&s, &cfg, &mut frames).unwrap();

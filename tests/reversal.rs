@@ -90,6 +90,7 @@ fn a_pocketed_ball_comes_back_out_at_the_mirror_time() {
                 reverse_at: Some(0.0),
                 frame_time: None,
             },
+            interrupt: None,
         };
         let mut rec = TraceRecorder::default();
         execute(&s, &cfg, &mut rec).unwrap();
@@ -124,6 +125,7 @@ fn forward_and_backward_events_mirror_each_other() {
             reverse_at: Some(0.0),
             frame_time: None,
         },
+        interrupt: None,
     };
     let mut rec = TraceRecorder::default();
     execute(&s, &cfg, &mut rec).unwrap();

@@ -17,6 +17,7 @@ fn run(s: &Scenario, engine: EngineKind) -> (Vec<TraceLine>, serde_json::Value) 
         until: s.until,
         check: true,
         span: Default::default(),
+        interrupt: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, serde_json::to_value(&report.summary).unwrap())

@@ -47,6 +47,7 @@ fn run_traced(s: &Scenario, engine: EngineKind, until: f64) -> (Report, TraceRec
         until,
         check: false,
         span: Default::default(),
+        interrupt: None,
     };
     let mut trace = TraceRecorder::default();
     let report = execute(s, &cfg, &mut trace).expect("the run completes");
@@ -59,6 +60,7 @@ fn run(s: &Scenario, engine: EngineKind, until: f64) -> Report {
         until,
         check: false,
         span: Default::default(),
+        interrupt: None,
     };
     execute(s, &cfg, &mut Ignore).expect("the run completes")
 }

@@ -20,6 +20,7 @@ fn run(s: &Scenario, engine: EngineKind) -> Run {
         until: s.until,
         check: true,
         span: Default::default(),
+        interrupt: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     Run {
@@ -237,6 +238,7 @@ fn rolling_back_for_memory_beside_final_batches_stays_exact() {
             until: s.until,
             check: true,
             span: Default::default(),
+            interrupt: None,
         };
         let mut rec = TraceRecorder::default();
         match execute(&s, &cfg, &mut rec) {
@@ -352,6 +354,7 @@ fn a_failing_sink_stops_every_worker_with_its_error() {
             until: s.until,
             check: false,
             span: Default::default(),
+            interrupt: None,
         };
         let mut obs = FailAt(0);
         match execute(&s, &cfg, &mut obs) {
@@ -386,6 +389,7 @@ fn the_projectors_frames_are_the_sequential_ones() {
                 frame_time: Some(0.1),
                 ..Span::default()
             },
+            interrupt: None,
         };
         let mut obs = Frames::default();
         execute(&s, &cfg, &mut obs).unwrap();

@@ -33,6 +33,7 @@ use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
 use pdes_kernel::prefetch::{prefetch, prefetch_all};
+use pdes_kernel::Interrupt;
 use smallvec::SmallVec;
 use std::cmp::Ordering;
 
@@ -198,6 +199,8 @@ pub struct EventList {
     stats: Stats,
     /// Stops an instant that never ends.
     instant: InstantCap,
+    /// Ends runs early, after the instant of the event that saw it raised.
+    interrupt: Option<Interrupt>,
 }
 
 /// Options of the event-list engine.
@@ -269,6 +272,7 @@ impl EventList {
             span: opts.span,
             frames: 0,
             stats: Stats::default(),
+            interrupt: None,
             instant: InstantCap::new(n),
         };
         // First predictions go into a provisional calendar; the real one's bucket width comes
@@ -486,8 +490,14 @@ impl EventList {
         self.own[i as usize].fixed_at = key.clone();
     }
 
+    /// Ends later runs early once `interrupt` is raised: at the time of the event that saw it,
+    /// every other event of that instant run too.
+    pub fn stop_on(&mut self, interrupt: Interrupt) {
+        self.interrupt = Some(interrupt);
+    }
+
     /// Runs until the next event would come after `until`, reporting each event to `obs`, and
-    /// returns the state at `until`.
+    /// returns the state at `until` (or at the earlier time an interrupt ended the run).
     pub fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
         self.run_for(until, u64::MAX, obs)
     }
@@ -537,6 +547,10 @@ impl EventList {
                 Partner::Fixed(f) => (self.hit(i, f, &key), i, f),
             };
             self.emit(&key, kind, a, b, &mut counts, obs)?;
+            // the rest of this instant happens too: the state at `now` is then complete
+            if self.interrupt.as_ref().is_some_and(Interrupt::raised) {
+                until = until.min(self.now);
+            }
         }
         self.now = self.now.max(until);
         Ok(self.outcome(until, counts))

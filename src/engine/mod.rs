@@ -15,6 +15,7 @@ pub mod time_step;
 use crate::geometry::{Trajectory, Vec2};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
+use pdes_kernel::Interrupt;
 
 /// What kind of physical event happened; the names are the trace's `kind` strings.
 #[derive(
@@ -324,6 +325,11 @@ pub trait Engine {
     /// returns the state at `until`.
     fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError>;
 
+    /// Ends later runs early, cleanly, once `interrupt` is raised: at a time of the engine's
+    /// choosing (the event or step that saw it, or where Time Warp's workers agree) with every
+    /// event up to it reported and the state at it returned.
+    fn stop_on(&mut self, interrupt: Interrupt);
+
     /// Time Warp's statistics, where Time Warp runs the engine.
     fn tw_stats(&self) -> Option<pdes_kernel::time_warp::TwStats> {
         None
@@ -337,17 +343,29 @@ impl Engine for event_list::EventList {
     fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
         event_list::EventList::run(self, until, obs)
     }
+
+    fn stop_on(&mut self, interrupt: Interrupt) {
+        event_list::EventList::stop_on(self, interrupt);
+    }
 }
 
 impl Engine for time_step::TimeStep {
     fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
         time_step::TimeStep::run(self, until, obs)
     }
+
+    fn stop_on(&mut self, interrupt: Interrupt) {
+        time_step::TimeStep::stop_on(self, interrupt);
+    }
 }
 
 impl Engine for objects::Objects {
     fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
         objects::Objects::run(self, until, obs)
+    }
+
+    fn stop_on(&mut self, interrupt: Interrupt) {
+        objects::Objects::stop_on(self, interrupt);
     }
 
     fn tw_stats(&self) -> Option<pdes_kernel::time_warp::TwStats> {

@@ -12,7 +12,7 @@ use crate::scenario::Scenario;
 use pdes_kernel::sequential::{Sequential, Sink};
 use pdes_kernel::time_warp::threads::{total_workers, TimeWarp};
 use pdes_kernel::time_warp::{TwConfig, TwStats};
-use pdes_kernel::{ExecError, Executor, MessageStats, Model, VTime};
+use pdes_kernel::{ExecError, Executor, Interrupt, MessageStats, Model, VTime};
 
 /// The objects engine over one scenario: plain or sectored.
 pub enum Objects {
@@ -41,13 +41,13 @@ where
 }
 
 /// Runs every batch up to `until`, each output to `sink`, which reads the balls' states only if
-/// `reads_balls`.
+/// `reads_balls`; returns the time the run ended at (earlier than `until` if interrupted).
 fn run_exec<M: Model>(
     e: &mut Exec<M>,
     until: f64,
     reads_balls: bool,
     sink: &mut Sink<'_, M, RunError>,
-) -> Result<(), RunError> {
+) -> Result<f64, RunError> {
     e.observe_states(reads_balls);
     e.run(until, sink).map_err(|e| match e {
         ExecError::Sink(e) => e,
@@ -172,6 +172,15 @@ impl Objects {
         }
     }
 
+    /// Ends later runs early, at a time when every event up to it has happened, once
+    /// `interrupt` is raised.
+    pub fn stop_on(&mut self, interrupt: Interrupt) {
+        match self {
+            Objects::Plain(e) => e.stop_on(interrupt),
+            Objects::Sectored(e) => e.stop_on(interrupt),
+        }
+    }
+
     /// Runs every batch up to time `until`, reporting each physical event to `obs`.
     pub fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
         match self {
@@ -179,7 +188,7 @@ impl Objects {
             Objects::Sectored(e) => {
                 let mut counts = EventCounts::default();
                 let mut instant = InstantCap::new(e.model().table().n_balls as usize);
-                run_exec(
+                let ended = run_exec(
                     e,
                     until,
                     obs.reads_balls(),
@@ -193,7 +202,7 @@ impl Objects {
                         obs.on_event(&ev, &view)
                     },
                 )?;
-                Ok(outcome(e, e.model().table(), until, counts))
+                Ok(outcome(e, e.model().table(), ended, counts))
             }
         }
     }
@@ -253,7 +262,7 @@ fn run_plain(
         // A frame is complete when every ball has drawn itself for it.
         let mut frame: Option<Frame> = None;
         let mut instant = InstantCap::new(n);
-        run_exec(
+        let ended = run_exec(
             exec,
             until,
             obs.reads_balls(),
@@ -287,6 +296,6 @@ fn run_plain(
                 }
             },
         )?;
-        Ok(outcome(exec, exec.model().table(), until, counts))
+        Ok(outcome(exec, exec.model().table(), ended, counts))
     }
 }

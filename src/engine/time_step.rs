@@ -15,6 +15,7 @@ use super::{
 use crate::geometry::{Trajectory, Vec2};
 use crate::physics;
 use crate::scenario::Scenario;
+use pdes_kernel::Interrupt;
 
 /// Options of the time-step engine.
 #[derive(Clone, Copy, Debug)]
@@ -58,6 +59,8 @@ pub struct TimeStep {
     /// Balls to come back out of their pocket after the reversal: (time, ball, pocket id).
     returns: Vec<(f64, u32, u32)>,
     stats: Stats,
+    /// Ends runs early, at the end of the step that saw it raised.
+    interrupt: Option<Interrupt>,
 }
 
 impl TimeStep {
@@ -82,6 +85,7 @@ impl TimeStep {
             reverse_at: opts.span.reverse_at,
             returns: Vec::new(),
             stats: Stats::default(),
+            interrupt: None,
         }
     }
 
@@ -232,7 +236,13 @@ impl TimeStep {
         Ok(())
     }
 
-    /// Runs until `until` in steps of `dt`, reporting each contact it finds to `obs`.
+    /// Ends later runs early once `interrupt` is raised: at the end of the step that saw it.
+    pub fn stop_on(&mut self, interrupt: Interrupt) {
+        self.interrupt = Some(interrupt);
+    }
+
+    /// Runs until `until` in steps of `dt`, reporting each contact it finds to `obs` (or to the
+    /// end of the step in which an interrupt came).
     pub fn run(&mut self, until: f64, obs: &mut dyn Observer) -> Result<Outcome, RunError> {
         let mut counts = EventCounts::default();
         let n = self.balls.len() as u32;
@@ -249,6 +259,9 @@ impl TimeStep {
             self.bring_back(&mut counts, obs)?;
             if self.reverse_at == Some(self.t) {
                 self.reverse();
+            }
+            if self.interrupt.as_ref().is_some_and(Interrupt::raised) {
+                return Ok(self.outcome(self.t, counts));
             }
         }
         Ok(self.outcome(until, counts))

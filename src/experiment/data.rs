@@ -154,6 +154,7 @@ fn physics(
         until,
         check: false,
         span: Default::default(),
+        interrupt: None,
     };
     let report = execute(s, &cfg, &mut fp).map_err(|source| ExperimentError::Physics {
         balls: n,
@@ -197,6 +198,7 @@ fn objects(
         until,
         check: false,
         span: Default::default(),
+        interrupt: None,
     };
     let fail = |source: RunError| ExperimentError::Objects {
         balls: n,

@@ -372,6 +372,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
             frame_time: (!sectored).then_some(cfg.frame_time),
             ..Span::default()
         },
+        interrupt: None,
     };
     let report = execute(scenario, &run, &mut rec)?;
     let chunks = chunked(scenario, cfg.engine, &times)?;

@@ -21,6 +21,7 @@ pub fn traced(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>,
         until: s.until,
         check,
         span: Default::default(),
+        interrupt: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.summary)

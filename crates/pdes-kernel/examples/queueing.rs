@@ -171,7 +171,7 @@ fn main() {
 
     let clock = std::time::Instant::now();
     let mut seq = Sequential::new(Network, stations(), VTime::start(0.0));
-    let Ok(()) = seq.run(UNTIL, &mut { never });
+    let Ok(_) = seq.run(UNTIL, &mut { never });
     let seq_seconds = clock.elapsed().as_secs_f64();
     let (seq_digest, seq_events) = (digest(seq.states()), seq.stats().delivered);
 

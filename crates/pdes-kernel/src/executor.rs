@@ -4,7 +4,7 @@
 use crate::sequential::{Sequential, Sink};
 use crate::time_warp::threads::TimeWarp;
 use crate::time_warp::{RoundRecord, TwStats};
-use crate::{MessageStats, Model};
+use crate::{Interrupt, MessageStats, Model};
 
 /// Why a run stopped early.
 #[derive(Debug, thiserror::Error)]
@@ -49,9 +49,14 @@ pub trait Executor<M: Model, E> {
         let _ = on;
     }
 
+    /// Ends later runs early, cleanly, once `interrupt` is raised (see [`crate::interrupt`]).
+    fn stop_on(&mut self, interrupt: Interrupt);
+
     /// Runs every batch with time at most `until`, passing each output, with the states just
     /// after its batch, to `sink` in the sequential order; stops at the sink's first error.
-    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), ExecError<E>>;
+    /// Returns the time the run ended at: `until`, or an earlier one an interrupt chose, every
+    /// batch up to it run and none after it.
+    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, ExecError<E>>;
 
     /// Frees the executor's memory (Time Warp's on each worker's own thread).
     fn free(self: Box<Self>) {}
@@ -74,7 +79,11 @@ impl<M: Model, E> Executor<M, E> for Sequential<M> {
         Sequential::pending_len(self)
     }
 
-    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), ExecError<E>> {
+    fn stop_on(&mut self, interrupt: Interrupt) {
+        Sequential::stop_on(self, interrupt);
+    }
+
+    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, ExecError<E>> {
         Sequential::run(self, until, sink).map_err(ExecError::Sink)
     }
 }
@@ -114,7 +123,11 @@ where
         self.ship_states(on);
     }
 
-    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), ExecError<E>> {
+    fn stop_on(&mut self, interrupt: Interrupt) {
+        TimeWarp::stop_on(self, interrupt);
+    }
+
+    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, ExecError<E>> {
         TimeWarp::run(self, until, sink)
     }
 

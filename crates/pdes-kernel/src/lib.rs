@@ -28,6 +28,7 @@
 
 pub mod digest;
 pub mod executor;
+pub mod interrupt;
 mod led_heap;
 pub mod phold;
 pub mod prefetch;
@@ -37,6 +38,7 @@ pub mod time;
 pub mod time_warp;
 
 pub use executor::{ExecError, Executor};
+pub use interrupt::Interrupt;
 pub use time::{PlainTime, Time, VTime};
 
 /// Pending messages an executor reserves room for per object (address space only until used,

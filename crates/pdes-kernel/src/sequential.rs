@@ -5,6 +5,7 @@ use super::queue::{Queue, Ranked};
 use super::{
     Ctx, Envelope, Handle, MessageStats, Model, Pending, Time, VTime, RESERVED_PER_OBJECT,
 };
+use crate::Interrupt;
 use rustc_hash::FxHashSet;
 use std::cmp::Ordering;
 
@@ -60,6 +61,8 @@ pub struct Sequential<M: Model> {
     batch: Vec<Envelope<M::Msg>>,
     sent: Vec<Pending<M::Time, M::Msg>>,
     retracted: Vec<Handle>,
+    /// Asks the run to end early.
+    interrupt: Option<Interrupt>,
 }
 
 impl<M: Model> Sequential<M> {
@@ -78,6 +81,7 @@ impl<M: Model> Sequential<M> {
             batch: Vec::new(),
             sent: Vec::new(),
             retracted: Vec::new(),
+            interrupt: None,
         };
         for me in 0..s.states.len() as u32 {
             let mut ctx = Ctx::new(&s.model, start.clone(), me, &mut s.seqs[me as usize]);
@@ -140,20 +144,38 @@ impl<M: Model> Sequential<M> {
         }
     }
 
+    /// Whether an interrupt asks the run to end.
+    #[inline]
+    fn interrupted(&self) -> bool {
+        self.interrupt.as_ref().is_some_and(Interrupt::raised)
+    }
+
+    /// Ends later runs early once `interrupt` is raised: at the time of the batch run last, every
+    /// other batch at that time run too.
+    pub fn stop_on(&mut self, interrupt: Interrupt) {
+        self.interrupt = Some(interrupt);
+    }
+
     /// Runs every batch with time at most `until`, passing each output, with the states after
     /// the batch that produced it, to `sink`; stops at the first error the sink returns.
-    pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), E> {
+    /// Returns the time the run ended at: `until`, or an earlier one where an interrupt
+    /// ([`Sequential::stop_on`]) ended it, every batch up to that time run.
+    pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, E> {
+        let mut until = until;
         loop {
+            if let Some(now) = self.now.as_ref().filter(|_| self.interrupted()) {
+                until = until.min(now.t());
+            }
             match self.pending.peek() {
                 Some(Item(p)) if p.time.t() <= until => {}
-                _ => return Ok(()),
+                _ => return Ok(until),
             }
             let Some(first) = self.pop_live() else {
-                return Ok(());
+                return Ok(until);
             };
             if first.time.t() > until {
                 self.pending.push(Item(first), false);
-                return Ok(());
+                return Ok(until);
             }
             let (time, to) = (first.time, first.to);
             let mut batch = std::mem::take(&mut self.batch);

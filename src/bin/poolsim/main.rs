@@ -10,6 +10,7 @@ mod phold;
 mod render;
 mod reverse;
 mod run;
+mod signals;
 mod values;
 
 use clap::{Parser, Subcommand};

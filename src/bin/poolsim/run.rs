@@ -1,6 +1,8 @@
 //! `poolsim run`: one scenario on one engine, with its trace, final state and summary.
 
 use crate::common::*;
+use crate::signals::{interrupted, stop_on_signals};
+use pdes_kernel::Interrupt;
 use crate::values::{nv_delay, sector_choice, Delay, Engine, News, Sectors};
 use pdes_kernel::time_warp::TwConfig;
 use poolsim::engine::{Event, Observer, RunError, World};
@@ -299,11 +301,14 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
             "--until: must be a finite number not below 0, got {until}"
         )));
     }
+    let interrupt = Interrupt::new();
+    stop_on_signals(&interrupt)?;
     let cfg = RunConfig {
         engine,
         until,
         check: a.check,
         span: Default::default(),
+        interrupt: Some(interrupt.clone()),
     };
     #[cfg(feature = "mpi")]
     let _mpi = if matches!(cfg.engine, EngineKind::TimeWarp { .. }) {
@@ -344,7 +349,7 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
         e => run_failure(e),
     })?;
     if !root {
-        return Ok(());
+        return interrupted(&interrupt, report.outcome.t);
     }
     if let Some(p) = &a.final_state {
         write_final_state(p, &report.outcome)?;
@@ -364,7 +369,7 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
         };
         written.map_err(|e| usage(format!("writing the summary failed: {e}")))?;
     }
-    Ok(())
+    interrupted(&interrupt, report.outcome.t)
 }
 
 /// Where the trace goes: the file at `p`, or stdout for `-`.
@@ -477,6 +482,12 @@ pub fn human_summary(s: &RunSummary) -> String {
             st.rollbacks,
             100.0 * tw.remote_fraction,
             st.gvt_rounds
+        ));
+    }
+    if let Some(i) = &s.interrupted {
+        lines.push(format!(
+            "interrupted   by {} at t = {:?}, every event up to it done",
+            i.signal, i.at
         ));
     }
     lines.join("\n") + "\n"

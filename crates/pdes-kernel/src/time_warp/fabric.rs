@@ -101,6 +101,11 @@ pub struct Reduction {
     /// all workers sweep in the same round, so that none waits at the next round for another
     /// to finish its sweep.
     pub sweep: u64,
+    /// Workers that saw an [`Interrupt`](crate::Interrupt) raised (summed).
+    pub interrupt: u64,
+    /// The latest time of a batch any worker has run, rolled back or not (maximum): where an
+    /// interrupted run ends, since no worker holds anything beyond it.
+    pub latest: f64,
 }
 
 impl Reduction {
@@ -111,6 +116,8 @@ impl Reduction {
             floor: self.floor.min(o.floor),
             stop: self.stop + o.stop,
             sweep: self.sweep + o.sweep,
+            interrupt: self.interrupt + o.interrupt,
+            latest: self.latest.max(o.latest),
         }
     }
 }

@@ -74,4 +74,4 @@ pub use config::{
 };
 pub use fabric::{Bounds, Chunk, Committed, CommittedOf, Fabric, Op, OpOf, Progress, Reduction};
 pub use floor::Floor;
-pub use worker::{Placement, Stop, Worker};
+pub use worker::{Halt, Placement, Stop, Worker};

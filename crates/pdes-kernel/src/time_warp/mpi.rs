@@ -275,14 +275,15 @@ where
                     parcels: Floor::INFINITY,
                 };
             }
-            // stop requests and sweep requests in one reduction
-            let mut flags = [0u64; 2];
+            // stop, sweep and interrupt requests in one reduction
+            let mut flags = [0u64; 3];
             world.all_reduce_into(
-                &[here.stop, here.sweep][..],
+                &[here.stop, here.sweep, here.interrupt][..],
                 &mut flags[..],
                 SystemOperation::sum(),
             );
-            (g.stop, g.sweep) = (flags[0], flags[1]);
+            (g.stop, g.sweep, g.interrupt) = (flags[0], flags[1], flags[2]);
+            world.all_reduce_into(&here.latest, &mut g.latest, SystemOperation::max());
             *self.result.lock().expect("no thread panicked") = g;
         }
         self.barrier.wait();

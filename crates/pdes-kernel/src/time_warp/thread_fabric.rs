@@ -12,6 +12,8 @@ pub const NOTHING: Reduction = Reduction {
     floor: Floor::INFINITY,
     stop: 0,
     sweep: 0,
+    interrupt: 0,
+    latest: f64::NEG_INFINITY,
 };
 
 /// Reductions among the threads of one process: three rotating slots and a barrier.

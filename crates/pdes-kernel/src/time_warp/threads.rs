@@ -3,10 +3,12 @@
 //! the sink.
 
 use super::thread_fabric::ThreadFabric;
-use super::{Chunk, CommittedOf, Fabric, Op, Placement, RoundRecord, TwConfig, TwStats, Worker};
+use super::{
+    Chunk, CommittedOf, Fabric, Halt, Op, Placement, RoundRecord, TwConfig, TwStats, Worker,
+};
 use crate::executor::ExecError;
 use crate::sequential::Sink;
-use crate::{MessageStats, Model, VTime};
+use crate::{Interrupt, MessageStats, Model, VTime};
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{mpsc, Arc};
@@ -167,6 +169,10 @@ pub struct TimeWarp<M: Model> {
     /// Whether the workers handed their final states to the collector after the last run
     /// (holding the collector's old ones in their place).
     handed_over: bool,
+    /// Where the last run ended (at first, where the objects started).
+    now: f64,
+    /// Asks runs to end early.
+    interrupt: Option<Interrupt>,
 }
 
 /// This process's MPI rank and the number of ranks; `(0, 1)` without MPI.
@@ -264,6 +270,8 @@ where
             collector,
             ranks,
             handed_over: false,
+            now: start.t(),
+            interrupt: None,
         }
     }
 
@@ -325,10 +333,17 @@ where
         self.collector.shipped = on;
     }
 
+    /// Ends later runs early once `interrupt` is raised on any rank: at the first GVT round
+    /// that sees it, every worker agrees to end at the latest batch any of them has run.
+    pub fn stop_on(&mut self, interrupt: Interrupt) {
+        self.interrupt = Some(interrupt);
+    }
+
     /// Runs every batch with time at most `until` optimistically on the workers; the sink sees
     /// each output, with the committed states just after its batch, in the sequential order
-    /// (on rank 0 only, under MPI).
-    pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<(), ExecError<E>> {
+    /// (on rank 0 only, under MPI). Returns the time the run ended at: `until`, or an earlier
+    /// one where an interrupt ([`TimeWarp::stop_on`]) ended it, every batch up to it run.
+    pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, ExecError<E>> {
         if std::mem::take(&mut self.handed_over) {
             for w in &mut self.workers {
                 w.restore_states(&self.collector.states);
@@ -371,10 +386,13 @@ where
             }
             self.handed_over = true;
         }
-        match failed {
-            Some(e) => Err(e),
-            None => Ok(()),
+        if let Some(e) = failed {
+            return Err(e);
         }
+        // every worker of every rank ended at the same time; with none, the run ends at once
+        let ended = self.workers.iter().map(|w| w.ended_at).fold(until, f64::min);
+        self.now = ended.max(self.now);
+        Ok(self.now)
     }
 
     /// Runs the workers on `fabric` until they stop, collecting what reaches `rx` meanwhile.
@@ -394,6 +412,7 @@ where
             workers,
             cfg,
             collector,
+            interrupt,
             ..
         } = self;
         let model: &M = model;
@@ -404,14 +423,18 @@ where
         let (finished, main) = (AtomicUsize::new(0), std::thread::current());
         std::thread::scope(|scope| {
             for w in workers.iter_mut() {
-                let (stop, cfg, ship) = (&stop, &*cfg, collector.shipped);
+                let (cfg, ship) = (&*cfg, collector.shipped);
+                let halt = Halt {
+                    failed: &stop,
+                    interrupt: interrupt.as_ref(),
+                };
                 let (finished, main) = (&finished, &main);
                 scope.spawn(move || {
                     let _end = WorkerEnd {
                         count: finished,
                         collector: main,
                     };
-                    w.run(model, fabric, cfg, until, ship, stop)
+                    w.run(model, fabric, cfg, until, ship, halt)
                 });
             }
             loop {

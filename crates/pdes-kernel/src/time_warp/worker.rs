@@ -13,7 +13,7 @@ use super::window::AutoWindow;
 use crate::prefetch::{prefetch, prefetch_all};
 use crate::queue::{Queue, Ranked};
 use crate::{
-    uid, Ctx, Envelope, Handle, MessageStats, Model, Pending, Saving, Time, VTime,
+    uid, Ctx, Envelope, Handle, Interrupt, MessageStats, Model, Pending, Saving, Time, VTime,
     RESERVED_PER_OBJECT, STATE_CLASSES,
 };
 use rand::{Rng, SeedableRng};
@@ -351,6 +351,10 @@ pub struct Worker<M: Model> {
     lookahead: f64,
     /// When the worker started its latest run.
     started: Option<std::time::Instant>,
+    /// The latest time of a batch this worker has run, rolled back or not.
+    latest: f64,
+    /// Where its latest run ended: the run's end, or the earlier time an interrupt chose.
+    pub ended_at: f64,
     /// Batches in a burst ([`TwConfig::burst`], at most a GVT interval).
     burst_len: u32,
     /// Whether the collector wants observed objects' states.
@@ -377,6 +381,15 @@ pub struct Worker<M: Model> {
     /// that passes them: the collector puts out a round's batches after the round before's,
     /// and a batch run as final may be later than one another worker commits a round after.
     to_ship: Vec<Committed<M::Time, M::State, M::Output>>,
+}
+
+/// What may end a worker's run early: another worker's failure, or an interrupt.
+#[derive(Clone, Copy)]
+pub struct Halt<'a> {
+    /// Raised when a worker failed or the sink returned an error: stop at the next round.
+    pub failed: &'a std::sync::atomic::AtomicBool,
+    /// Raised to end the run cleanly at a time every worker agrees on.
+    pub interrupt: Option<&'a Interrupt>,
 }
 
 /// Why a worker stopped early.
@@ -443,6 +456,8 @@ impl<M: Model> Worker<M> {
             final_ok: false,
             lookahead: 0.0,
             started: None,
+            latest: f64::NEG_INFINITY,
+            ended_at: f64::NEG_INFINITY,
             burst_len: DEFAULT_BURST,
             ship: false,
             final_bound: Floor::NEG_INFINITY,
@@ -788,6 +803,7 @@ impl<M: Model> Worker<M> {
             return false;
         }
         let (time, mut taken) = self.take_batch();
+        self.latest = self.latest.max(time.t());
         let run_final = self.settle_final(model, fabric, &time, &mut taken);
         // the next batch's object, most likely (a local one: its message is here): where it
         // lives now, and its record once the handler has run (not at once: the record's place
@@ -1208,7 +1224,12 @@ impl<M: Model> Worker<M> {
 
     /// A GVT round: returns the reduction over all workers, whose floor is GVT (every batch
     /// before it is final).
-    fn gvt_round<F: Fabric<M>>(&mut self, fabric: &F, stop: bool) -> Result<Reduction, Stop> {
+    fn gvt_round<F: Fabric<M>>(
+        &mut self,
+        fabric: &F,
+        stop: bool,
+        interrupt: bool,
+    ) -> Result<Reduction, Stop> {
         let mut buf = Vec::new();
         loop {
             self.receive(fabric, &mut buf);
@@ -1218,6 +1239,8 @@ impl<M: Model> Worker<M> {
                 floor: self.local_min(),
                 stop: u64::from(stop),
                 sweep: u64::from(self.heap_marked_over(ASK_SWEEP)),
+                interrupt: u64::from(interrupt),
+                latest: self.latest,
             };
             let g = fabric.reduce(self.index, local);
             if g.stop > 0 {
@@ -1411,8 +1434,9 @@ impl<M: Model> Worker<M> {
         cfg: &TwConfig,
         until: f64,
         ship: bool,
-        stop: &std::sync::atomic::AtomicBool,
+        halt: Halt<'_>,
     ) -> Result<(), Stop> {
+        let mut until = until;
         let mut buf = Vec::new();
         let mut since = 0u32;
         self.lookahead = model.lookahead();
@@ -1447,19 +1471,23 @@ impl<M: Model> Worker<M> {
                 continue;
             }
             since = 0;
-            let asked = stop.load(std::sync::atomic::Ordering::Relaxed);
-            match self.gvt_round(fabric, asked || over || self.fault.is_some()) {
+            let asked = halt.failed.load(std::sync::atomic::Ordering::Relaxed);
+            let interrupted = halt.interrupt.is_some_and(Interrupt::raised);
+            match self.gvt_round(fabric, asked || over || self.fault.is_some(), interrupted) {
                 Err(s) => break Err(self.why_stopped(s, over, cfg)),
-                Ok(Reduction {
-                    floor: gvt, sweep, ..
-                }) => {
-                    self.advance_gvt(model, fabric, gvt, sweep > 0);
-                    if gvt.t > until {
+                Ok(g) => {
+                    // every worker ends at the same time: nobody has run a batch after it
+                    if g.interrupt > 0 {
+                        until = until.min(g.latest.max(self.gvt.t));
+                    }
+                    self.advance_gvt(model, fabric, g.floor, g.sweep > 0);
+                    if g.floor.t > until {
                         break Ok(());
                     }
                 }
             }
         };
+        self.ended_at = until;
         self.finish(fabric, &result);
         result
     }
