@@ -279,6 +279,7 @@ mod tests {
             checked: false,
             engine_stats: BTreeMap::new(),
             time_warp: None,
+            interrupted: None,
         };
         let text = serde_json::to_string(&s).unwrap();
         assert!(
@@ -286,6 +287,17 @@ mod tests {
             "{text}"
         );
         assert!(!text.contains("time_warp"), "{text}");
+        assert!(!text.contains("interrupted"), "{text}");
         assert_eq!(serde_json::from_str::<RunSummary>(&text).unwrap(), s);
+        let stopped = RunSummary {
+            interrupted: Some(Interruption::new(0.25, libc::SIGTERM as usize)),
+            ..s
+        };
+        let text = serde_json::to_string(&stopped).unwrap();
+        assert!(
+            text.contains(r#""interrupted":{"at":0.25,"signal":"SIGTERM"}"#),
+            "{text}"
+        );
+        assert_eq!(serde_json::from_str::<RunSummary>(&text).unwrap(), stopped);
     }
 }

@@ -79,7 +79,8 @@ fn check(engine: &[&str], signal: i32, name: &str) {
     assert_eq!(cut.code, Some(128 + signal), "{engine:?}: {}", cut.stderr);
     assert_eq!(cut.stderr.lines().count(), 1, "{engine:?}: {}", cut.stderr);
     assert!(
-        cut.stderr.starts_with(&format!("poolsim: interrupted by {name} at t = ")),
+        cut.stderr
+            .starts_with(&format!("poolsim: interrupted by {name} at t = ")),
         "{engine:?}: {}",
         cut.stderr
     );
@@ -108,7 +109,10 @@ fn check(engine: &[&str], signal: i32, name: &str) {
         "{engine:?}: digests"
     );
     assert!(cut.trace == whole.trace, "{engine:?}: traces differ");
-    assert_eq!(cut.final_state, whole.final_state, "{engine:?}: final states");
+    assert_eq!(
+        cut.final_state, whole.final_state,
+        "{engine:?}: final states"
+    );
 }
 
 #[test]
@@ -137,7 +141,14 @@ fn sigterm_stops_the_sectored_objects_cleanly() {
 #[test]
 fn sigint_stops_time_warp_cleanly() {
     check(
-        &["--engine", "time-warp", "--workers", "2", "--sectors", "auto"],
+        &[
+            "--engine",
+            "time-warp",
+            "--workers",
+            "2",
+            "--sectors",
+            "auto",
+        ],
         libc::SIGINT,
         "SIGINT",
     );

@@ -208,3 +208,89 @@ fn checked_run_on_ranks() {
         );
     }
 }
+
+/// SIGINT sent to one rank alone stops every rank at the same time: rank 0 writes the trace,
+/// the final state and a summary that say where, equal to a sequential run to that time, and
+/// the signalled rank exits with 130.
+#[test]
+fn a_signal_to_one_rank_stops_them_all_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("cut.jsonl");
+    let trace_arg = trace.to_str().unwrap();
+    let child = Command::new("mpirun")
+        .args(["--allow-run-as-root", "--oversubscribe", "-np", "2", BIN])
+        .args([
+            "run",
+            "gas",
+            "--balls",
+            "2500",
+            "--sectors",
+            "auto",
+            "--until",
+            "1e6",
+        ])
+        .args([
+            "--engine",
+            "time-warp",
+            "--workers",
+            "1",
+            "--json",
+            "--quiet",
+        ])
+        .args(["--trace", trace_arg])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("mpirun starts");
+    let started = std::time::Instant::now();
+    while std::fs::metadata(&trace).map_or(0, |m| m.len()) < 200_000 {
+        assert!(started.elapsed().as_secs() < 60, "no trace after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // the ranks are the processes whose command line names this test's trace file, mpirun
+    // among them: signal the last-started one
+    let ranks = Command::new("pgrep")
+        .args(["-n", "-f", &format!("^{BIN} .*{trace_arg}")])
+        .output()
+        .expect("pgrep runs");
+    let pid: i32 = String::from_utf8_lossy(&ranks.stdout)
+        .trim()
+        .parse()
+        .expect("a rank's pid");
+    assert_ne!(pid, child.id() as i32, "a rank, not mpirun");
+    // SAFETY: sends a signal to one rank of the job this test started.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGINT) }, 0);
+    let out = child.wait_with_output().expect("mpirun ends");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("poolsim: interrupted by SIGINT at t = "),
+        "{stderr}"
+    );
+    let got: serde_json::Value = serde_json::from_slice(&out.stdout).expect("rank 0's summary");
+    assert_eq!(got["interrupted"]["signal"], "SIGINT");
+    let at = got["interrupted"]["at"].as_f64().unwrap();
+    let until = format!("{at:?}");
+    let want_trace = dir.path().join("want.jsonl");
+    let want = poolsim(
+        None,
+        None,
+        &[
+            "run",
+            "gas",
+            "--balls",
+            "2500",
+            "--sectors",
+            "auto",
+            "--until",
+            &until,
+            "--engine",
+            "objects",
+            "--json",
+            "--quiet",
+            "--trace",
+            want_trace.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(got["final_state_digest"], want["final_state_digest"]);
+    assert_eq!(read(&trace), read(&want_trace), "traces differ");
+}

@@ -120,7 +120,6 @@ fn delay_mode_loses_an_update_as_in_table_2() {
     let cfg = RunConfig {
         engine: exact,
         ..cfg
-        interrupt: None,
     };
     let report = execute(&s, &cfg, &mut poolsim::engine::Ignore).unwrap();
     let v: Vec<f64> = report

@@ -129,7 +129,10 @@ fn check_cut(what: &str, got: (f64, Vec<(u32, u64, f64)>, Vec<Count>), until: f6
     let (whole_end, whole, _) = run(None, until, None);
     assert_eq!(whole_end, until);
     let cut: Vec<_> = whole.into_iter().filter(|o| o.2 <= ended).collect();
-    assert!(seen == cut, "{what}: outputs differ from the run cut at {ended}");
+    assert!(
+        seen == cut,
+        "{what}: outputs differ from the run cut at {ended}"
+    );
     let (_, _, to_there) = run(None, ended, None);
     assert!(
         states == to_there,

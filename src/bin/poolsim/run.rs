@@ -2,9 +2,9 @@
 
 use crate::common::*;
 use crate::signals::{interrupted, stop_on_signals};
-use pdes_kernel::Interrupt;
 use crate::values::{nv_delay, sector_choice, Delay, Engine, News, Sectors};
 use pdes_kernel::time_warp::TwConfig;
+use pdes_kernel::Interrupt;
 use poolsim::engine::{Event, Observer, RunError, World};
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};

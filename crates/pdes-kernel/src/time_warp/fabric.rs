@@ -101,7 +101,8 @@ pub struct Reduction {
     /// all workers sweep in the same round, so that none waits at the next round for another
     /// to finish its sweep.
     pub sweep: u64,
-    /// Workers that saw an [`Interrupt`](crate::Interrupt) raised (summed).
+    /// The cause of an [`Interrupt`](crate::Interrupt) a worker saw raised, 0 for none
+    /// (maximum): every rank learns of it, and raises its own.
     pub interrupt: u64,
     /// The latest time of a batch any worker has run, rolled back or not (maximum): where an
     /// interrupted run ends, since no worker holds anything beyond it.
@@ -116,7 +117,7 @@ impl Reduction {
             floor: self.floor.min(o.floor),
             stop: self.stop + o.stop,
             sweep: self.sweep + o.sweep,
-            interrupt: self.interrupt + o.interrupt,
+            interrupt: self.interrupt.max(o.interrupt),
             latest: self.latest.max(o.latest),
         }
     }

@@ -275,14 +275,15 @@ where
                     parcels: Floor::INFINITY,
                 };
             }
-            // stop, sweep and interrupt requests in one reduction
-            let mut flags = [0u64; 3];
+            // stop requests and sweep requests in one reduction
+            let mut flags = [0u64; 2];
             world.all_reduce_into(
-                &[here.stop, here.sweep, here.interrupt][..],
+                &[here.stop, here.sweep][..],
                 &mut flags[..],
                 SystemOperation::sum(),
             );
-            (g.stop, g.sweep, g.interrupt) = (flags[0], flags[1], flags[2]);
+            (g.stop, g.sweep) = (flags[0], flags[1]);
+            world.all_reduce_into(&here.interrupt, &mut g.interrupt, SystemOperation::max());
             world.all_reduce_into(&here.latest, &mut g.latest, SystemOperation::max());
             *self.result.lock().expect("no thread panicked") = g;
         }

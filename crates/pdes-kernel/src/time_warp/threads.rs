@@ -390,7 +390,11 @@ where
             return Err(e);
         }
         // every worker of every rank ended at the same time; with none, the run ends at once
-        let ended = self.workers.iter().map(|w| w.ended_at).fold(until, f64::min);
+        let ended = self
+            .workers
+            .iter()
+            .map(|w| w.ended_at)
+            .fold(until, f64::min);
         self.now = ended.max(self.now);
         Ok(self.now)
     }

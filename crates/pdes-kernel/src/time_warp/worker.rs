@@ -1228,7 +1228,7 @@ impl<M: Model> Worker<M> {
         &mut self,
         fabric: &F,
         stop: bool,
-        interrupt: bool,
+        interrupt: usize,
     ) -> Result<Reduction, Stop> {
         let mut buf = Vec::new();
         loop {
@@ -1239,7 +1239,7 @@ impl<M: Model> Worker<M> {
                 floor: self.local_min(),
                 stop: u64::from(stop),
                 sweep: u64::from(self.heap_marked_over(ASK_SWEEP)),
-                interrupt: u64::from(interrupt),
+                interrupt: interrupt as u64,
                 latest: self.latest,
             };
             let g = fabric.reduce(self.index, local);
@@ -1472,13 +1472,17 @@ impl<M: Model> Worker<M> {
             }
             since = 0;
             let asked = halt.failed.load(std::sync::atomic::Ordering::Relaxed);
-            let interrupted = halt.interrupt.is_some_and(Interrupt::raised);
-            match self.gvt_round(fabric, asked || over || self.fault.is_some(), interrupted) {
+            let cause = halt.interrupt.and_then(Interrupt::cause).unwrap_or(0);
+            match self.gvt_round(fabric, asked || over || self.fault.is_some(), cause) {
                 Err(s) => break Err(self.why_stopped(s, over, cfg)),
                 Ok(g) => {
                     // every worker ends at the same time: nobody has run a batch after it
                     if g.interrupt > 0 {
                         until = until.min(g.latest.max(self.gvt.t));
+                        // every rank's caller learns why its run ended early
+                        if let Some(i) = halt.interrupt {
+                            i.raise(g.interrupt as usize);
+                        }
                     }
                     self.advance_gvt(model, fabric, g.floor, g.sweep > 0);
                     if g.floor.t > until {
