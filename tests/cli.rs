@@ -959,3 +959,51 @@ fn flags_are_named_as_given() {
     ]);
     assert_eq!(r["engine"], "time-warp", "{r}");
 }
+
+/// A run that cannot fit in memory is refused before it allocates (a built-in before it is
+/// generated), with one line naming what it needs and what there is; `--memory-limit` sets the
+/// limit checked against, and `none` checks nothing.
+#[test]
+fn runs_too_large_for_memory_are_refused_before_they_allocate() {
+    let started = std::time::Instant::now();
+    let mut huge = vec!["run", "gas", "--balls", "100000000"];
+    // on a machine that could hold it, the limit given stands in for what it has
+    let room = poolsim::memory::available().map_or(0, |a| a.bytes);
+    if room >= poolsim::memory::least(100_000_000) {
+        huge.extend(["--memory-limit", "16G"]);
+    }
+    let line = failure(&huge, 2);
+    assert!(
+        line.contains("--balls: 100000000 balls need at least")
+            && line.contains("GiB")
+            && line.contains("--memory-limit"),
+        "{line}"
+    );
+    assert!(
+        started.elapsed().as_secs() < 5,
+        "refused before the scenario is generated"
+    );
+    let line = failure(
+        &[
+            "run",
+            "gas",
+            "--balls",
+            "10000",
+            "--engine",
+            "objects",
+            "--memory-limit",
+            "100M",
+        ],
+        2,
+    );
+    assert!(
+        line.contains("10000 balls on the objects engine without sectors need about")
+            && line.contains("100.0 MiB this run may take (--memory-limit)"),
+        "{line}"
+    );
+    let fits = ["run", "gas", "--balls", "400", "--json", "--memory-limit"];
+    success_json(&[&fits[..], &["none"]].concat());
+    success_json(&[&fits[..], &["1G"]].concat());
+    failure(&[&fits[..], &["1M"]].concat(), 2);
+    bad_usage(&["run", "gas", "--memory-limit", "lots"]);
+}

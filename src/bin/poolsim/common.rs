@@ -64,10 +64,14 @@ pub struct Progress {
     pub bar: ProgressBar,
     pub until: f64,
     pub seen: u64,
+    /// The trace file, whose size the line shows.
+    pub trace: Option<std::path::PathBuf>,
 }
 
 impl Progress {
-    pub fn new(until: f64, quiet: bool) -> Option<Progress> {
+    /// The progress line of a run to `until` (none when quiet or stderr is not a terminal);
+    /// with a trace file, it shows how much of the trace is written.
+    pub fn new(until: f64, quiet: bool, trace: Option<&std::path::Path>) -> Option<Progress> {
         if quiet || !std::io::stderr().is_terminal() || until.is_nan() || until <= 0.0 {
             return None;
         }
@@ -84,6 +88,7 @@ impl Progress {
             bar,
             until,
             seen: 0,
+            trace: trace.filter(|p| p.as_os_str() != "-").map(Into::into),
         })
     }
 }
@@ -94,8 +99,12 @@ impl Observer for Progress {
         if self.seen.is_multiple_of(8192) {
             self.bar
                 .set_position((ev.t / self.until * 1000.0).clamp(0.0, 1000.0) as u64);
+            let written = match self.trace.as_deref().map(std::fs::metadata) {
+                Some(Ok(m)) => format!(", trace {}", poolsim::memory::human_bytes(m.len())),
+                _ => String::new(),
+            };
             self.bar.set_message(format!(
-                "t = {:.3} / {}, {} events",
+                "t = {:.3} / {}, {} events{written}",
                 ev.t, self.until, self.seen
             ));
         }

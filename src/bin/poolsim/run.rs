@@ -2,10 +2,11 @@
 
 use crate::common::*;
 use crate::signals::{interrupted, stop_on_signals};
-use crate::values::{nv_delay, sector_choice, Delay, Engine, News, Sectors};
+use crate::values::{nv_delay, sector_choice, Delay, Engine, MemoryLimit, News, Sectors};
 use pdes_kernel::time_warp::TwConfig;
 use pdes_kernel::Interrupt;
 use poolsim::engine::{Event, Observer, RunError, World};
+use poolsim::memory::human_bytes;
 use poolsim::model::pool::NvDelay;
 use poolsim::output::{FinalState, TraceWriter};
 use poolsim::run::{execute, EngineKind, RunConfig};
@@ -77,6 +78,10 @@ pub struct RunArgs {
     /// No progress bar and no human summary (`--json` still prints).
     #[arg(long)]
     pub quiet: bool,
+    /// The memory to check the run's estimate against before it allocates (512M, 8G, 1.5T),
+    /// or none; by default what this machine and its control group have available.
+    #[arg(long = "memory-limit")]
+    pub memory_limit: Option<MemoryLimit>,
 }
 
 impl RunArgs {
@@ -109,6 +114,7 @@ impl RunArgs {
             fixed_news: None,
             dt: None,
             quiet: true,
+            memory_limit: None,
         }
     }
 }
@@ -288,8 +294,19 @@ pub fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure
 /// Runs `poolsim run`: the scenario on its engine, the trace as it goes, then the final state
 /// and the summary.
 pub fn run(a: &RunArgs) -> Result<(), Failure> {
+    // a built-in is generated in memory: refuse what no engine could hold before that
+    if let Some(n) = a.gen.balls {
+        let least = poolsim::memory::least(n);
+        fits(a.memory_limit, least, || {
+            format!(
+                "--balls: {n} balls need at least {} on any engine",
+                human_bytes(least)
+            )
+        })?;
+    }
     let scenario = load(&a.scenario, &a.gen)?;
     let engine = engine_of(a, &scenario)?;
+    check_memory(a, &scenario, &engine)?;
     if !matches!(engine, EngineKind::EventList | EngineKind::TimeStep { .. }) {
         poolsim::memory::transparent_huge_pages(false);
     }
@@ -322,7 +339,7 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
         Some(p) => Some(TraceWriter::new(trace_file(p)?)),
         None => None,
     };
-    let mut progress = Progress::new(until, a.quiet || !root);
+    let mut progress = Progress::new(until, a.quiet || !root, a.trace.as_deref());
     let report = {
         let mut sinks = Sinks {
             trace: trace.as_mut(),
@@ -491,4 +508,62 @@ pub fn human_summary(s: &RunSummary) -> String {
         ));
     }
     lines.join("\n") + "\n"
+}
+
+/// Refuses a run whose estimated memory is more than it may take, before it allocates; says
+/// so, unless quiet, when the engine grows with the square of the balls.
+fn check_memory(a: &RunArgs, scenario: &Scenario, engine: &EngineKind) -> Result<(), Failure> {
+    let n = scenario.balls.len();
+    let need = poolsim::memory::estimate(n, engine);
+    fits(a.memory_limit, need.bytes, || {
+        format!(
+            "{}: {n} balls on the {} engine{} need about {}",
+            a.scenario,
+            engine.name(),
+            if need.quadratic {
+                " without sectors"
+            } else {
+                ""
+            },
+            human_bytes(need.bytes)
+        )
+    })?;
+    if need.quadratic && need.bytes > QUADRATIC_NOTE && !a.quiet {
+        eprintln!(
+            "poolsim: note: without sectors every ball object keeps a record of every other \
+             ball: {n} balls need about {} and a set-up that grows as the square of the balls \
+             (--sectors auto keeps both linear)",
+            human_bytes(need.bytes)
+        );
+    }
+    Ok(())
+}
+
+/// Above this estimate, a run whose memory grows as the square of the balls says so.
+const QUADRATIC_NOTE: u64 = 256 << 20;
+
+/// Checks `need` bytes against `limit`, or against what is available; the refusal is
+/// `what()` and why, one line, exit 2.
+fn fits(limit: Option<MemoryLimit>, need: u64, what: impl Fn() -> String) -> Result<(), Failure> {
+    let (room, source) = match limit {
+        Some(MemoryLimit::None) => return Ok(()),
+        Some(MemoryLimit::Bytes(b)) => (b, "--memory-limit"),
+        None => match poolsim::memory::available() {
+            Some(a) => (a.bytes, a.source),
+            None => return Ok(()),
+        },
+    };
+    if need <= room {
+        return Ok(());
+    }
+    let hint = if limit.is_some() {
+        ""
+    } else {
+        "; --memory-limit SIZE or none overrides the check"
+    };
+    Err(usage(format!(
+        "{}, more than the {} this run may take ({source}){hint}",
+        what(),
+        human_bytes(room)
+    )))
 }

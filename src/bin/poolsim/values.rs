@@ -146,6 +146,46 @@ pub fn nv_delay(arg: Option<Delay>, s: &Scenario) -> NvDelay {
     }
 }
 
+/// `--memory-limit`: the memory a run is checked against before it allocates, in place of what
+/// the machine has available; `none` checks nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MemoryLimit {
+    /// This many bytes.
+    Bytes(u64),
+    /// No check.
+    None,
+}
+
+impl FromStr for MemoryLimit {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<MemoryLimit, String> {
+        if text == "none" {
+            return Ok(MemoryLimit::None);
+        }
+        let bad = || {
+            format!(
+                "expected a size such as 512M, 8G or 1.5T (binary units), or none, got `{text}`"
+            )
+        };
+        let lower = text.to_ascii_lowercase();
+        let number = lower.trim_end_matches("ib").trim_end_matches('b');
+        let (digits, shift) = match number.chars().last() {
+            Some('k') => (&number[..number.len() - 1], 10),
+            Some('m') => (&number[..number.len() - 1], 20),
+            Some('g') => (&number[..number.len() - 1], 30),
+            Some('t') => (&number[..number.len() - 1], 40),
+            _ => (number, 0),
+        };
+        let value: f64 = digits.trim().parse().map_err(|_| bad())?;
+        let bytes = value * (1u64 << shift) as f64;
+        if !(bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64) {
+            return Err(bad());
+        }
+        Ok(MemoryLimit::Bytes(bytes as u64))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,5 +209,18 @@ mod tests {
         assert!("-1".parse::<Delay>().unwrap_err().contains("-1"));
         assert!("inf".parse::<Delay>().unwrap_err().contains("finite"));
         assert!("soon".parse::<Delay>().unwrap_err().contains("`soon`"));
+    }
+
+    #[test]
+    fn memory_limits_read_binary_units_and_none() {
+        let bytes = |t: &str| t.parse::<MemoryLimit>();
+        assert_eq!(bytes("512M"), Ok(MemoryLimit::Bytes(512 << 20)));
+        assert_eq!(bytes("8GiB"), Ok(MemoryLimit::Bytes(8 << 30)));
+        assert_eq!(bytes("1.5t"), Ok(MemoryLimit::Bytes(3 << 39)));
+        assert_eq!(bytes("4096"), Ok(MemoryLimit::Bytes(4096)));
+        assert_eq!(bytes("none"), Ok(MemoryLimit::None));
+        for bad in ["", "G", "-1G", "0", "lots", "1e30T", "nan"] {
+            assert!(bytes(bad).is_err(), "{bad}");
+        }
     }
 }
