@@ -60,6 +60,7 @@ fn main() {
             check: false,
             span: Default::default(),
             interrupt: None,
+            checkpoint_every: None,
         },
         &mut Ignore,
     )
@@ -77,6 +78,7 @@ fn main() {
         check: true,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let report = execute(&settled, &cfg, &mut walls).expect("the gas runs");
 

@@ -42,6 +42,7 @@ fn main() {
             check: true,
             span: Default::default(),
             interrupt: None,
+            checkpoint_every: None,
         };
         let mut pockets = Pockets::default();
         let report = execute(&table, &cfg, &mut pockets).expect("the shot runs");

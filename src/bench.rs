@@ -655,6 +655,7 @@ pub fn measure_time_warp(
             check: false,
             span: Default::default(),
             interrupt: None,
+            checkpoint_every: None,
         };
         let report = execute(&scenario, &cfg, &mut Ignore)?;
         let s = &report.summary;

@@ -15,6 +15,7 @@
 pub mod analytic;
 pub mod bench;
 pub mod check;
+pub mod checkpoint;
 pub mod engine;
 #[cfg(feature = "pictures")]
 pub mod experiment;

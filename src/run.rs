@@ -4,11 +4,12 @@
 //! `poolsim run`, `poolsim demo` and `poolsim bench`; the binary only parses arguments.
 
 use crate::check::Checker;
+use crate::checkpoint::Checkpoint;
 use crate::engine::event_list::{self, EventList};
 use crate::engine::objects::Objects;
 use crate::engine::time_step::{self, TimeStep};
 use crate::engine::{
-    BallState, Engine, Event, Frame, Observer, Outcome, RunError, Span, Table, World,
+    BallState, Engine, Event, EventCounts, Frame, Observer, Outcome, RunError, Span, Table, World,
 };
 use crate::model::pool::NvDelay;
 /// Which balls tell the fixed objects of a sectored table (re-exported for engine choices).
@@ -144,6 +145,10 @@ pub struct RunConfig {
     /// signal's number): the run stops at a time of the engine's choosing, every event up to
     /// it reported, and its report says so.
     pub interrupt: Option<Interrupt>,
+    /// Simulation time between checkpoints: the run stops at each multiple of it after the
+    /// start (and where an interrupt stops it, and at its end) and hands its observer a
+    /// [`Checkpoint`]. Not on the time-step engine, whose state is its grid of steps.
+    pub checkpoint_every: Option<f64>,
 }
 
 /// What a run produced.
@@ -201,6 +206,10 @@ impl Observer for Sinks<'_> {
     fn on_frame(&mut self, frame: &Frame, table: &Table) -> Result<(), RunError> {
         self.user.on_frame(frame, table)
     }
+
+    fn on_checkpoint(&mut self, checkpoint: Checkpoint) -> Result<(), RunError> {
+        self.user.on_checkpoint(checkpoint)
+    }
 }
 
 /// Refuses a ball so fast that it crosses its own radius in less time than the run's clock can
@@ -233,6 +242,13 @@ pub fn build_engine(scenario: &Scenario, cfg: &RunConfig) -> Result<Box<dyn Engi
                 ..Default::default()
             };
             Box::new(EventList::new(scenario, opts))
+        }
+        EngineKind::TimeStep { .. } if scenario.balls.iter().any(|b| b.fixed.is_some()) => {
+            return Err(RunError::Input(
+                "the time-step engine does not take up a checkpoint: its state is its grid of \
+                 steps"
+                    .into(),
+            ))
         }
         EngineKind::TimeStep { dt } => {
             let steps = (cfg.until - cfg.span.start) / dt;
@@ -309,7 +325,12 @@ pub fn execute(
     }
     // the engine built and its objects set up, before the first event
     let setup = start.elapsed().as_secs_f64();
-    let outcome = engine.run(cfg.until, &mut sinks)?;
+    let (e0, _) = energies(&initial);
+    let outcome = if cfg.checkpoint_every.is_some() {
+        run_with_checkpoints(engine.as_mut(), scenario, cfg, e0, &mut sinks)?
+    } else {
+        engine.run(cfg.until, &mut sinks)?
+    };
     let time_warp = engine.tw_stats();
     engine.free();
     // every engine ends with a sweep of the state it ends in (a tunnelled ball has no event);
@@ -319,7 +340,6 @@ pub fn execute(
         c.sweep_final(&table, &outcome.balls, outcome.t)?;
     }
     let wall = start.elapsed().as_secs_f64();
-    let (e0, _) = energies(&initial);
     let (e1, ep) = energies(&outcome.balls);
     let n_events = outcome.events.total();
     let engine_stats = outcome
@@ -360,6 +380,53 @@ pub fn execute(
         max_energy_drift: max_drift,
         summary,
     })
+}
+
+/// Runs `engine` to `cfg.until` in stretches of `cfg.checkpoint_every`, handing `obs` a
+/// checkpoint after each, after an interrupted one, and at the end; the outcome counts every
+/// stretch's events.
+fn run_with_checkpoints(
+    engine: &mut dyn Engine,
+    scenario: &Scenario,
+    cfg: &RunConfig,
+    initial_energy: f64,
+    obs: &mut dyn Observer,
+) -> Result<Outcome, RunError> {
+    let every = cfg.checkpoint_every.expect("checkpoints asked for");
+    let mut events = EventCounts::default();
+    for k in 1u64.. {
+        let next = (cfg.span.start + k as f64 * every).min(cfg.until);
+        let mut outcome = engine.run(next, obs)?;
+        for (all, more) in events.by_kind.iter_mut().zip(outcome.events.by_kind) {
+            *all += more;
+        }
+        outcome.events = events;
+        let Some(balls) = engine.balls_to_take_up() else {
+            return Err(RunError::Input(format!(
+                "--checkpoint: the {} engine cannot be taken up exactly",
+                cfg.engine.name()
+            )));
+        };
+        obs.on_checkpoint(Checkpoint {
+            format: crate::checkpoint::FORMAT.into(),
+            version: crate::checkpoint::VERSION,
+            t: outcome.t,
+            until: cfg.until,
+            engine: cfg.engine.name().into(),
+            scenario: Scenario {
+                balls,
+                ..scenario.clone()
+            },
+            events: EventTotals::from(&events),
+            initial_energy,
+            trace: None,
+        })?;
+        // the end, or an interrupt before the stretch's end
+        if outcome.t >= cfg.until || outcome.t < next {
+            return Ok(outcome);
+        }
+    }
+    unreachable!("a run ends")
 }
 
 /// What a reversal run (thesis 4.6–4.7) found.
@@ -417,6 +484,7 @@ pub fn reverse(
             frame_time: None,
         },
         interrupt: None,
+        checkpoint_every: None,
     };
     let mut forward = Forward(0);
     let report = execute(scenario, &cfg, &mut forward)?;

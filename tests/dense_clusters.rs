@@ -22,6 +22,8 @@ fn scenario(name: &str, centres: &[Vec2], radius: f64, speed: f64, (w, h): (f64,
             velocity: Vec2::new(rng.gen_range(-speed..speed), rng.gen_range(-speed..speed)),
             radius,
             mass: 1.0,
+            fixed: None,
+            pocket: None,
         })
         .collect();
     let c = |a: (f64, f64), b: (f64, f64)| CushionSpec {
@@ -96,6 +98,8 @@ fn grains_and_a_boulder(side: f64) -> Scenario {
         velocity: Vec2::new(3.0, 2.0),
         radius: 5.0,
         mass: 1.0,
+        fixed: None,
+        pocket: None,
     });
     s.until = 3.0;
     s

@@ -774,6 +774,7 @@ fn every_scenario_on_every_engine_ends_as_recorded() {
             check: false,
             span: Default::default(),
             interrupt: None,
+            checkpoint_every: None,
         };
         let report = execute(&s, &cfg, &mut Ignore)
             .unwrap_or_else(|e| panic!("{name} on {engine_name}: {e}"));

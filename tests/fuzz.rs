@@ -165,6 +165,7 @@ fn digest(s: &Scenario, engine: EngineKind, check: bool) -> Result<String, RunEr
         check,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     execute(s, &cfg, &mut Ignore).map(|r| r.summary.final_state_digest)
 }

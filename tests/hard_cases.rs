@@ -22,6 +22,7 @@ fn run(s: &Scenario) -> (Vec<TraceLine>, Vec<BallState>) {
         check: true,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.outcome.balls)

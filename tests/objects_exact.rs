@@ -101,6 +101,7 @@ fn delay_mode_loses_an_update_as_in_table_2() {
         check: false,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let report = execute(&s, &cfg, &mut poolsim::engine::Ignore).unwrap();
     let v: Vec<f64> = report
@@ -219,6 +220,7 @@ fn projector_frames_match_the_event_list() {
                 check: true,
                 span,
                 interrupt: None,
+                checkpoint_every: None,
             };
             let mut frames = Frames::default();
             let report = execute(&s, &cfg, &mut frames).unwrap();

@@ -91,6 +91,7 @@ fn a_pocketed_ball_comes_back_out_at_the_mirror_time() {
                 frame_time: None,
             },
             interrupt: None,
+            checkpoint_every: None,
         };
         let mut rec = TraceRecorder::default();
         execute(&s, &cfg, &mut rec).unwrap();
@@ -126,6 +127,7 @@ fn forward_and_backward_events_mirror_each_other() {
             frame_time: None,
         },
         interrupt: None,
+        checkpoint_every: None,
     };
     let mut rec = TraceRecorder::default();
     execute(&s, &cfg, &mut rec).unwrap();

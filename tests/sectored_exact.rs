@@ -18,6 +18,7 @@ fn run(s: &Scenario, engine: EngineKind) -> (Vec<TraceLine>, serde_json::Value) 
         check: true,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, serde_json::to_value(&report.summary).unwrap())

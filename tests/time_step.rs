@@ -48,6 +48,7 @@ fn run_traced(s: &Scenario, engine: EngineKind, until: f64) -> (Report, TraceRec
         check: false,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let mut trace = TraceRecorder::default();
     let report = execute(s, &cfg, &mut trace).expect("the run completes");
@@ -61,6 +62,7 @@ fn run(s: &Scenario, engine: EngineKind, until: f64) -> Report {
         check: false,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     execute(s, &cfg, &mut Ignore).expect("the run completes")
 }

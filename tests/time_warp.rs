@@ -21,6 +21,7 @@ fn run(s: &Scenario, engine: EngineKind) -> Run {
         check: true,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     Run {
@@ -239,6 +240,7 @@ fn rolling_back_for_memory_beside_final_batches_stays_exact() {
             check: true,
             span: Default::default(),
             interrupt: None,
+            checkpoint_every: None,
         };
         let mut rec = TraceRecorder::default();
         match execute(&s, &cfg, &mut rec) {
@@ -355,6 +357,7 @@ fn a_failing_sink_stops_every_worker_with_its_error() {
             check: false,
             span: Default::default(),
             interrupt: None,
+            checkpoint_every: None,
         };
         let mut obs = FailAt(0);
         match execute(&s, &cfg, &mut obs) {
@@ -390,6 +393,7 @@ fn the_projectors_frames_are_the_sequential_ones() {
                 ..Span::default()
             },
             interrupt: None,
+            checkpoint_every: None,
         };
         let mut obs = Frames::default();
         execute(&s, &cfg, &mut obs).unwrap();

@@ -30,7 +30,7 @@ use super::{
 };
 use crate::geometry::Trajectory;
 use crate::physics::{self, Contact};
-use crate::scenario::Scenario;
+use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
 use pdes_kernel::prefetch::{prefetch, prefetch_all};
 use pdes_kernel::Interrupt;
@@ -229,7 +229,7 @@ impl EventList {
         let balls = BallState::initial(s, start);
         let n = balls.len();
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let centres: Vec<_> = balls.iter().map(|b| b.traj.position).collect();
+        let centres: Vec<_> = balls.iter().map(|b| b.position(start)).collect();
         let mut grid = Grid::new(
             &table,
             &centres,
@@ -240,7 +240,11 @@ impl EventList {
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                let cell = grid.insert_at(i as u32, b.traj.position);
+                // a ball in a pocket (taken up from a checkpoint) is in no cell
+                let cell = match b.pocket {
+                    Some(_) => NOT_ON_TABLE,
+                    None => grid.insert_at(i as u32, b.traj.at(start)),
+                };
                 Slot {
                     traj: b.traj,
                     radius: b.radius,
@@ -253,18 +257,20 @@ impl EventList {
         let mut e = EventList {
             table,
             slots,
-            own: balls
+            own: s
+                .balls
                 .iter()
-                .map(|b| Own {
+                .zip(&balls)
+                .map(|(spec, b)| Own {
                     phys: Best::none(),
                     queued: Key::at(f64::INFINITY, 0),
-                    fixed_at: Key::start(start),
+                    fixed_at: spec.fixed_at(start),
                     mass: b.mass,
                     cross_cell: 0,
                     place: Place::NOWHERE,
                 })
                 .collect(),
-            pocket: vec![None; n],
+            pocket: balls.iter().map(|b| b.pocket).collect(),
             queue: Calendar::heap_only(start),
             grid,
             now: start,
@@ -729,6 +735,26 @@ impl EventList {
     }
 
     /// Every ball's state fixed at time `t` (not before the last event).
+    /// Every ball as a run that takes this one up must start it: its trajectory as last fixed,
+    /// with the key that fixed it, and its pocket.
+    pub fn balls_to_take_up(&self) -> Vec<BallSpec> {
+        (0..self.slots.len())
+            .map(|i| {
+                let (slot, own) = (&self.slots[i], &self.own[i]);
+                debug_assert_eq!(slot.traj.t0, own.fixed_at.t, "fixed when it turned");
+                BallSpec {
+                    position: slot.traj.position,
+                    velocity: slot.traj.velocity,
+                    radius: slot.radius,
+                    mass: own.mass,
+                    fixed: Some(own.fixed_at.clone()),
+                    pocket: self.pocket[i],
+                }
+            })
+            .collect()
+    }
+
+    /// Every ball's state at time `t`.
     pub fn state_at(&self, t: f64) -> Vec<BallState> {
         (0..self.slots.len() as u32)
             .map(|i| {

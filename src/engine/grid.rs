@@ -786,6 +786,8 @@ mod tests {
             velocity: Vec2::ZERO,
             radius: 1.0,
             mass: 1.0,
+            fixed: None,
+            pocket: None,
         };
         Table::new(&Scenario {
             name: "grid".to_string(),

@@ -12,6 +12,7 @@ pub mod objects;
 pub mod partition;
 pub mod time_step;
 
+use crate::checkpoint::Checkpoint;
 use crate::geometry::{Trajectory, Vec2};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
@@ -258,7 +259,8 @@ impl Span {
 }
 
 impl BallState {
-    /// The initial states of a scenario's balls, fixed at time `start`.
+    /// The initial states of a scenario's balls in a run that starts at `start` (each fixed
+    /// there, or where a checkpoint says).
     pub fn initial(s: &Scenario, start: f64) -> Vec<BallState> {
         s.balls
             .iter()
@@ -266,11 +268,11 @@ impl BallState {
                 traj: Trajectory {
                     position: b.position,
                     velocity: b.velocity,
-                    t0: start,
+                    t0: b.fixed.as_ref().map_or(start, |k| k.t),
                 },
                 radius: b.radius,
                 mass: b.mass,
-                pocket: None,
+                pocket: b.pocket,
             })
             .collect()
     }
@@ -330,6 +332,13 @@ pub trait Engine {
     /// event up to it reported and the state at it returned.
     fn stop_on(&mut self, interrupt: Interrupt);
 
+    /// Every ball as a run that takes this one up exactly must start it (its trajectory as
+    /// last fixed, with the key that fixed it, and its pocket); `None` where the engine cannot
+    /// be taken up exactly (the time-step engine, whose state is its grid of steps).
+    fn balls_to_take_up(&self) -> Option<Vec<crate::scenario::BallSpec>> {
+        None
+    }
+
     /// Time Warp's statistics, where Time Warp runs the engine.
     fn tw_stats(&self) -> Option<pdes_kernel::time_warp::TwStats> {
         None
@@ -346,6 +355,10 @@ impl Engine for event_list::EventList {
 
     fn stop_on(&mut self, interrupt: Interrupt) {
         event_list::EventList::stop_on(self, interrupt);
+    }
+
+    fn balls_to_take_up(&self) -> Option<Vec<crate::scenario::BallSpec>> {
+        Some(event_list::EventList::balls_to_take_up(self))
     }
 }
 
@@ -368,6 +381,10 @@ impl Engine for objects::Objects {
         objects::Objects::stop_on(self, interrupt);
     }
 
+    fn balls_to_take_up(&self) -> Option<Vec<crate::scenario::BallSpec>> {
+        Some(objects::Objects::balls_to_take_up(self))
+    }
+
     fn tw_stats(&self) -> Option<pdes_kernel::time_warp::TwStats> {
         objects::Objects::tw_stats(self)
     }
@@ -387,6 +404,12 @@ pub trait Observer {
     /// the balls' states on other threads (Time Warp) ships them only when some observer does.
     fn reads_balls(&self) -> bool {
         true
+    }
+
+    /// Called with the run's complete state at each checkpoint
+    /// ([`crate::run::RunConfig::checkpoint_every`]); an error stops the run.
+    fn on_checkpoint(&mut self, _checkpoint: Checkpoint) -> Result<(), RunError> {
+        Ok(())
     }
 
     /// Called with each frame, in time order, when the run was asked for frames.
@@ -419,6 +442,10 @@ impl<O: Observer + ?Sized> Observer for &mut O {
 
     fn on_frame(&mut self, frame: &Frame, table: &Table) -> Result<(), RunError> {
         (**self).on_frame(frame, table)
+    }
+
+    fn on_checkpoint(&mut self, checkpoint: Checkpoint) -> Result<(), RunError> {
+        (**self).on_checkpoint(checkpoint)
     }
 }
 

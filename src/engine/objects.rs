@@ -8,7 +8,7 @@ use super::{
 };
 use crate::model::pool::{BallInfo, NvDelay, Pool, PoolOutput, PoolState};
 use crate::model::sectored::{Layout, SecState, Sectored};
-use crate::scenario::Scenario;
+use crate::scenario::{BallSpec, Scenario};
 use pdes_kernel::sequential::{Sequential, Sink};
 use pdes_kernel::time_warp::threads::{total_workers, TimeWarp};
 use pdes_kernel::time_warp::{TwConfig, TwStats};
@@ -172,6 +172,15 @@ impl Objects {
         }
     }
 
+    /// Every ball as a run that takes this one up must start it: its trajectory as last fixed,
+    /// with the key that fixed it, and its pocket (the committed states, after a run).
+    pub fn balls_to_take_up(&self) -> Vec<BallSpec> {
+        match self {
+            Objects::Plain(e) => take_up(e, e.model().table().n_balls),
+            Objects::Sectored(e) => take_up(e, e.model().table().n_balls),
+        }
+    }
+
     /// Ends later runs early, at a time when every event up to it has happened, once
     /// `interrupt` is raised.
     pub fn stop_on(&mut self, interrupt: Interrupt) {
@@ -206,6 +215,28 @@ impl Objects {
             }
         }
     }
+}
+
+/// The balls of either model's committed states, as a run taking this one up starts them.
+fn take_up<M>(e: &Exec<M>, n_balls: u32) -> Vec<BallSpec>
+where
+    M: Model,
+    M::State: BallOf,
+{
+    e.states()[..n_balls as usize]
+        .iter()
+        .map(|s| {
+            let b = s.ball_info();
+            BallSpec {
+                position: b.traj.position,
+                velocity: b.traj.velocity,
+                radius: b.radius,
+                mass: b.mass,
+                fixed: Some(b.fixed.clone()),
+                pocket: b.pocket,
+            }
+        })
+        .collect()
 }
 
 /// The end of a run of either model: balls at `until` and the message counts.

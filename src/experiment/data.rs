@@ -155,6 +155,7 @@ fn physics(
         check: false,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let report = execute(s, &cfg, &mut fp).map_err(|source| ExperimentError::Physics {
         balls: n,
@@ -199,6 +200,7 @@ fn objects(
         check: false,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let fail = |source: RunError| ExperimentError::Objects {
         balls: n,

@@ -60,19 +60,21 @@ pub struct BallInfo {
 }
 
 impl BallInfo {
-    /// A ball of the scenario as it starts at `t0`, shared with the messages that will carry it.
-    pub fn starting(b: &BallSpec, t0: f64) -> Arc<BallInfo> {
+    /// A ball of the scenario as a run that starts at `start` takes it (fixed there, or where
+    /// a checkpoint says), shared with the messages that will carry it.
+    pub fn starting(b: &BallSpec, start: f64) -> Arc<BallInfo> {
+        let fixed = b.fixed_at(start);
         Arc::new(BallInfo {
             traj: Trajectory {
                 position: b.position,
                 velocity: b.velocity,
-                t0,
+                t0: fixed.t,
             },
             radius: b.radius,
             mass: b.mass,
-            fixed: Key::start(t0),
+            fixed,
             version: 0,
-            pocket: None,
+            pocket: b.pocket,
         })
     }
 

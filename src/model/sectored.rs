@@ -35,6 +35,7 @@ pub use super::layout::{FixedNews, Layout};
 use super::pool::{cancel_with, BallInfo, Planned, Plans};
 use super::MessageKind;
 use crate::engine::{Event, Span, Table};
+use crate::geometry::{Trajectory, Vec2};
 use crate::physics::{self, Contact};
 use crate::polygon;
 use crate::scenario::{BallSpec, Scenario};
@@ -277,6 +278,19 @@ pub struct Sectored {
     far_fixed: Vec<u32>,
 }
 
+/// Where ball `b` is when a run that starts at `start` takes it up.
+fn starting_position(b: &BallSpec, start: f64) -> Vec2 {
+    match &b.fixed {
+        None => b.position,
+        Some(k) => Trajectory {
+            position: b.position,
+            velocity: b.velocity,
+            t0: k.t,
+        }
+        .at(start),
+    }
+}
+
 impl Sectored {
     /// The model and initial states of a validated scenario over `layout`, starting at
     /// `span.start` (frames are not drawn here); the balls' sectors are found on `threads`
@@ -296,11 +310,15 @@ impl Sectored {
                 .map(|b| SecState::Ball {
                     info: BallInfo::starting(b, span.start),
                     planned: Vec::new(),
-                    sectors: layout
-                        .touching(b.position, b.radius)
-                        .into_iter()
-                        .map(|k| first_sector + k)
-                        .collect(),
+                    // where it is at the start; a ball in a pocket is in no sector
+                    sectors: match b.pocket {
+                        Some(_) => SmallVec::new(),
+                        None => layout
+                            .touching(starting_position(b, span.start), b.radius)
+                            .into_iter()
+                            .map(|k| first_sector + k)
+                            .collect(),
+                    },
                     awaiting: Vec::new(),
                 })
                 .collect()

@@ -373,6 +373,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
             ..Span::default()
         },
         interrupt: None,
+        checkpoint_every: None,
     };
     let report = execute(scenario, &run, &mut rec)?;
     let chunks = chunked(scenario, cfg.engine, &times)?;

@@ -258,6 +258,8 @@ fn ball(x: f64, y: f64, vx: f64, vy: f64, radius: f64) -> BallSpec {
         velocity: Vec2::new(vx, vy),
         radius,
         mass: 1.0,
+        fixed: None,
+        pocket: None,
     }
 }
 
@@ -431,6 +433,8 @@ fn gas(p: &Params) -> Result<Scenario, Invalid> {
             velocity: random_velocity(&mut rng, vmax),
             radius: r,
             mass: 1.0,
+            fixed: None,
+            pocket: None,
         })
         .collect();
     Ok(Scenario {
@@ -457,6 +461,8 @@ fn reversal(p: &Params) -> Result<Scenario, Invalid> {
                 velocity: random_velocity(&mut rng, vmax),
                 radius: REVERSAL_RADIUS,
                 mass: 1.0,
+                fixed: None,
+                pocket: None,
             });
         }
     }

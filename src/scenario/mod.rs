@@ -9,6 +9,7 @@ pub mod builtin;
 pub mod toml;
 
 use crate::geometry::Vec2;
+use crate::vtime::Key;
 use std::fmt;
 
 /// The most sectors a grid given by hand may have: 500 × 500. A sector costs its polygon, its
@@ -16,22 +17,40 @@ use std::fmt;
 /// 10^4 × 10^4 gigabytes (`--sectors auto` keeps to about eight balls per sector instead).
 pub const MAX_SECTORS: u64 = 250_000;
 
-/// A ball at time 0.
-#[derive(Clone, Debug, PartialEq)]
+/// A ball as a run starts it: where it is and how it moves at the start (or, taken up from a
+/// checkpoint, since the event that last fixed its trajectory).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BallSpec {
-    /// Centre at time 0 (length).
+    /// Centre at the start, or at `fixed.t` (length).
     pub position: Vec2,
-    /// Velocity at time 0 (length per time).
+    /// Velocity (length per time).
     pub velocity: Vec2,
     /// Radius (length), positive.
     pub radius: f64,
     /// Mass (any consistent unit), positive.
     pub mass: f64,
+    /// The key of the event that fixed its trajectory, in a run taken up from a checkpoint:
+    /// `position` is then its centre at `fixed.t`, and the keys of its immediate collisions
+    /// descend from this one, exactly as in the run that wrote the checkpoint. `None`: fixed at
+    /// the run's start.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fixed: Option<Key>,
+    /// The pocket (from 0) it dropped into, in a run taken up from a checkpoint: `position` is
+    /// then where it crossed into it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pocket: Option<u32>,
+}
+
+impl BallSpec {
+    /// The key its trajectory was fixed at, in a run that starts at `start`.
+    pub fn fixed_at(&self, start: f64) -> Key {
+        self.fixed.clone().unwrap_or_else(|| Key::start(start))
+    }
 }
 
 /// A straight cushion. Going from `from` to `to`, the table lies on the right (thesis 3.1.2 and
 /// DESIGN.md: cushions run clockwise around the table).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CushionSpec {
     /// First end (length).
     pub from: Vec2,
@@ -43,7 +62,7 @@ pub struct CushionSpec {
 
 /// A pocket: a line that a ball's centre crosses to drop in (thesis 3.1.3), with a corner at each
 /// end (thesis 3.1.4). Oriented like a cushion: the table lies on the right going `from` → `to`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PocketSpec {
     /// First end (length); the first corner of the pocket stands here.
     pub from: Vec2,
@@ -55,7 +74,7 @@ pub struct PocketSpec {
 
 /// How the table is divided into sectors (chapter 5). Kept from the scenario for the sectored
 /// engines; the event-list engine ignores it.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum SectorSpec {
     /// A grid of `nx` × `ny` equal rectangles over the table's bounding box.
     Grid {
@@ -69,7 +88,7 @@ pub enum SectorSpec {
 }
 
 /// A whole scenario: the table, the balls at time 0 and the default end time.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Scenario {
     /// Name shown in summaries: the built-in's name or the file path.
     pub name: String,
@@ -234,6 +253,44 @@ impl Scenario {
     /// Checks every rule engines rely on; the first broken one is returned with its field path.
     /// Overlap is found with a sort along x, so validation of a million balls stays fast.
     pub fn validate(&self) -> Result<(), Invalid> {
+        self.check_balls_and_table()?;
+        self.check_on_table()?;
+        self.check_overlaps()?;
+        self.check_sectors()
+    }
+
+    /// Checks a scenario taken up from a checkpoint at time `t`: sound numbers, a sound table
+    /// and sectors, and every ball's trajectory fixed by `t`, in a pocket that exists. Where the
+    /// balls are is not checked again: each position is the centre at its own time.
+    pub fn validate_taken_up(&self, t: f64) -> Result<(), Invalid> {
+        self.check_balls_and_table()?;
+        for (i, b) in self.balls.iter().enumerate() {
+            let f = format!("ball[{}]", i + 1);
+            match &b.fixed {
+                None => return Err(invalid(format!("{f}.fixed"), "is missing".into())),
+                Some(k) if !(k.t.is_finite() && k.t <= t) => {
+                    return Err(invalid(
+                        format!("{f}.fixed"),
+                        format!(
+                            "must be a time no later than the checkpoint's {t}, got {}",
+                            k.t
+                        ),
+                    ))
+                }
+                Some(_) => {}
+            }
+            if let Some(k) = b.pocket.filter(|&k| k as usize >= self.pockets.len()) {
+                return Err(invalid(
+                    format!("{f}.pocket"),
+                    format!("names pocket {k} (from 0) of {}", self.pockets.len()),
+                ));
+            }
+        }
+        self.check_sectors()
+    }
+
+    /// Checks the numbers of every ball, the end time, and the cushions and pockets.
+    fn check_balls_and_table(&self) -> Result<(), Invalid> {
         if self.balls.is_empty() {
             return Err(invalid(
                 "ball".into(),
@@ -279,9 +336,7 @@ impl Scenario {
             check_segment(&f, p.from, p.to)?;
             check_elasticity(&format!("{f}.corner_elasticity"), p.corner_elasticity)?;
         }
-        self.check_on_table()?;
-        self.check_overlaps()?;
-        self.check_sectors()
+        Ok(())
     }
 
     fn check_overlaps(&self) -> Result<(), Invalid> {

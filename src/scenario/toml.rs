@@ -240,6 +240,8 @@ impl RawFile {
                         .map_or(Vec2::ZERO, |v| v.get_ref().vec()),
                     radius: *b.radius.get_ref(),
                     mass: opt(&b.mass, 1.0),
+                    fixed: None,
+                    pocket: None,
                 }
             })
             .collect();
@@ -665,6 +667,8 @@ grid = [2, 3]
                 velocity: Vec2::new(10.0, 0.0),
                 radius: 20.0,
                 mass: 1.0,
+                fixed: None,
+                pocket: None,
             }
         );
         assert_eq!(s.balls[1].velocity, Vec2::ZERO);

@@ -22,6 +22,7 @@ pub fn traced(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>,
         check,
         span: Default::default(),
         interrupt: None,
+        checkpoint_every: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.summary)
@@ -86,6 +87,8 @@ pub fn random_scenario() -> impl Strategy<Value = Scenario> {
                         velocity: Vec2::new(speed * dir.cos(), speed * dir.sin()),
                         radius,
                         mass: rng.gen_range(0.5..3.0),
+                        fixed: None,
+                        pocket: None,
                     });
                 }
             }

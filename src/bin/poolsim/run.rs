@@ -326,6 +326,7 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
         check: a.check,
         span: Default::default(),
         interrupt: Some(interrupt.clone()),
+        checkpoint_every: None,
     };
     #[cfg(feature = "mpi")]
     let _mpi = if matches!(cfg.engine, EngineKind::TimeWarp { .. }) {
