@@ -30,12 +30,23 @@ impl TraceLine {
 /// Writes one JSON line per event to `out`.
 pub struct TraceWriter<W: Write> {
     out: W,
+    lines: u64,
 }
 
 impl<W: Write> TraceWriter<W> {
-    /// A trace writer over `out` (wrap files in a `BufWriter`).
-    pub fn new(out: W) -> TraceWriter<W> {
-        TraceWriter { out }
+    /// A trace writer over `out` (wrap files in a `BufWriter`) that holds `lines` lines already.
+    pub fn new(out: W, lines: u64) -> TraceWriter<W> {
+        TraceWriter { out, lines }
+    }
+
+    /// The lines in the trace so far.
+    pub fn lines(&self) -> u64 {
+        self.lines
+    }
+
+    /// Writes out what is buffered.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
     }
 
     /// Flushes and returns the writer.
@@ -49,6 +60,7 @@ impl<W: Write> Observer for TraceWriter<W> {
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
         let line = TraceLine::new(ev, world.table());
         serde_json::to_writer(&mut self.out, &line).map_err(|e| RunError::Output(e.to_string()))?;
+        self.lines += 1;
         self.out
             .write_all(b"\n")
             .map_err(|e| RunError::Output(e.to_string()))

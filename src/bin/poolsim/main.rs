@@ -3,6 +3,7 @@
 //! 1 internal failure or a failed `--check`.
 
 mod bench;
+mod checkpoints;
 mod common;
 mod experiment;
 mod model;
@@ -82,6 +83,10 @@ enum Command {
     /// Run from -Q to 0, reverse every ball, run on to Q, and report how far the balls end from
     /// where they started (thesis 4.6-4.7).
     Reverse(Box<ReverseArgs>),
+    /// Take a run up from a checkpoint (`run --checkpoint FILE`) and run it on to --until (the
+    /// checkpoint's own end by default), continuing its trace; any engine but the time-step
+    /// one ends in the same state.
+    Resume(Box<RunArgs>),
 }
 
 /// Lets a closed pipe end the process quietly, as it does every Unix filter (`poolsim bench |
@@ -158,6 +163,7 @@ fn main() -> ExitCode {
         Command::Bench(b) => bench::bench(b),
         Command::Phold(a) => phold(a),
         Command::Reverse(a) => reverse(a),
+        Command::Resume(a) => checkpoints::resume(a),
         Command::Model(a) => model(a),
         Command::Experiment(a) => experiment::experiment(a),
     };

@@ -1,19 +1,20 @@
 //! `poolsim run`: one scenario on one engine, with its trace, final state and summary.
 
+use crate::checkpoints::{open_trace, Saver, Trace};
 use crate::common::*;
 use crate::signals::{interrupted, stop_on_signals};
 use crate::values::{nv_delay, sector_choice, Delay, Engine, MemoryLimit, News, Sectors};
 use pdes_kernel::time_warp::TwConfig;
 use pdes_kernel::Interrupt;
-use poolsim::engine::{Event, Observer, RunError, World};
+use poolsim::checkpoint::Checkpoint;
+use poolsim::engine::{Event, Observer, RunError, Span, World};
 use poolsim::memory::human_bytes;
 use poolsim::model::pool::NvDelay;
-use poolsim::output::{FinalState, TraceWriter};
+use poolsim::output::FinalState;
 use poolsim::run::{execute, EngineKind, RunConfig};
 use poolsim::scenario::Scenario;
-use poolsim::summary::RunSummary;
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use poolsim::summary::{KineticEnergy, RunSummary};
+use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(clap::Args, Clone, Debug)]
@@ -82,6 +83,13 @@ pub struct RunArgs {
     /// or none; by default what this machine and its control group have available.
     #[arg(long = "memory-limit")]
     pub memory_limit: Option<MemoryLimit>,
+    /// Write the run's complete state here (atomically) at the end, where an interrupt stops
+    /// it, and every --checkpoint-every; `poolsim resume FILE` takes the run up from it.
+    #[arg(long)]
+    pub checkpoint: Option<PathBuf>,
+    /// Simulation time between checkpoints.
+    #[arg(long = "checkpoint-every", allow_negative_numbers = true)]
+    pub checkpoint_every: Option<f64>,
 }
 
 impl RunArgs {
@@ -115,6 +123,8 @@ impl RunArgs {
             dt: None,
             quiet: true,
             memory_limit: None,
+            checkpoint: None,
+            checkpoint_every: None,
         }
     }
 }
@@ -205,9 +215,10 @@ pub fn tw_config(a: &RunArgs) -> Result<TwConfig, Failure> {
     Ok(tw)
 }
 
-/// The trace and the final state must go to two files, neither of them the scenario: writing
-/// one would truncate the other.
-pub fn check_outputs_apart(a: &RunArgs) -> Result<(), Failure> {
+/// The trace, the final state and the checkpoint must go to different files, none of them the
+/// scenario (a checkpoint taken up may be written over by the run's own): writing one would
+/// truncate another.
+pub fn check_outputs_apart(a: &RunArgs, resuming: bool) -> Result<(), Failure> {
     // where a path points, resolved as far as it exists; devices such as /dev/null are shared
     let resolved = |p: &std::path::Path| {
         if p.exists() && !p.is_file() {
@@ -225,22 +236,26 @@ pub fn check_outputs_apart(a: &RunArgs) -> Result<(), Failure> {
         named(x) && named(y) && resolved(x).is_some_and(|x| resolved(y) == Some(x))
     };
     let scenario = std::path::Path::new(&a.scenario);
-    for (flag, out) in [("--trace", &a.trace), ("--final-state", &a.final_state)] {
-        if let Some(out) = out {
-            if same(out, scenario) {
+    let outputs = [
+        ("--trace", &a.trace),
+        ("--final-state", &a.final_state),
+        ("--checkpoint", &a.checkpoint),
+    ];
+    for (k, &(flag, out)) in outputs.iter().enumerate() {
+        let Some(out) = out else { continue };
+        if same(out, scenario) && !(resuming && flag == "--checkpoint") {
+            return Err(usage(format!(
+                "{flag}: {} is the scenario file; writing it would destroy it",
+                out.display()
+            )));
+        }
+        for &(other, theirs) in &outputs[k + 1..] {
+            if theirs.as_ref().is_some_and(|o| same(out, o)) {
                 return Err(usage(format!(
-                    "{flag}: {} is the scenario file; writing it would destroy it",
+                    "{flag} and {other}: both name {}; give two files",
                     out.display()
                 )));
             }
-        }
-    }
-    if let (Some(t), Some(f)) = (&a.trace, &a.final_state) {
-        if same(t, f) {
-            return Err(usage(format!(
-                "--trace and --final-state: both name {}; give two files",
-                t.display()
-            )));
         }
     }
     Ok(())
@@ -305,29 +320,54 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
         })?;
     }
     let scenario = load(&a.scenario, &a.gen)?;
-    let engine = engine_of(a, &scenario)?;
-    check_memory(a, &scenario, &engine)?;
+    run_from(a, &scenario, None)
+}
+
+/// The settings of a run of `scenario` from its start, or from checkpoint `from` (whose
+/// scenario it is), as the arguments ask, checked.
+fn config_of(
+    a: &RunArgs,
+    scenario: &Scenario,
+    from: Option<&Checkpoint>,
+) -> Result<RunConfig, Failure> {
+    let engine = engine_of(a, scenario)?;
+    check_memory(a, scenario, &engine)?;
     if !matches!(engine, EngineKind::EventList | EngineKind::TimeStep { .. }) {
         poolsim::memory::transparent_huge_pages(false);
     }
     check_options_fit(a, &engine)?;
-    check_outputs_apart(a)?;
-    let until = a.until.unwrap_or(scenario.until);
+    check_outputs_apart(a, from.is_some())?;
+    let until = a.until.unwrap_or(from.map_or(scenario.until, |c| c.until));
     if !until.is_finite() || until < 0.0 {
         return Err(usage(format!(
             "--until: must be a finite number not below 0, got {until}"
         )));
     }
-    let interrupt = Interrupt::new();
-    stop_on_signals(&interrupt)?;
-    let cfg = RunConfig {
+    let start = from.map_or(0.0, |c| c.t);
+    Ok(RunConfig {
+        checkpoint_every: checkpoint_every(a, &engine, start, until)?,
         engine,
         until,
         check: a.check,
-        span: Default::default(),
-        interrupt: Some(interrupt.clone()),
-        checkpoint_every: None,
-    };
+        span: Span {
+            start,
+            ..Span::default()
+        },
+        interrupt: None,
+    })
+}
+
+/// Runs `scenario` as `a` asks, from its start or from checkpoint `from`: the trace as it goes
+/// (continuing `from`'s), checkpoints, then the final state and the summary.
+pub fn run_from(
+    a: &RunArgs,
+    scenario: &Scenario,
+    from: Option<&Checkpoint>,
+) -> Result<(), Failure> {
+    let mut cfg = config_of(a, scenario, from)?;
+    let interrupt = Interrupt::new();
+    stop_on_signals(&interrupt)?;
+    cfg.interrupt = Some(interrupt.clone());
     #[cfg(feature = "mpi")]
     let _mpi = if matches!(cfg.engine, EngineKind::TimeWarp { .. }) {
         start_mpi()?
@@ -336,17 +376,28 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
     };
     // under MPI only rank 0 writes anything
     let root = pdes_kernel::time_warp::threads::collects_results();
+    let mark = from.and_then(|c| c.trace.as_ref());
     let mut trace = match a.trace.as_ref().filter(|_| root) {
-        Some(p) => Some(TraceWriter::new(trace_file(p)?)),
+        Some(p) => Some(open_trace(p, mark)?),
         None => None,
     };
-    let mut progress = Progress::new(until, a.quiet || !root, a.trace.as_deref());
+    let saver = a.checkpoint.as_ref().filter(|_| root).map(|p| Saver {
+        path: p.clone(),
+        trace_path: a
+            .trace
+            .as_ref()
+            .filter(|t| t.as_os_str() != "-")
+            .map(|t| t.display().to_string()),
+        base: from.map(|c| (c.events, c.initial_energy)),
+    });
+    let mut progress = Progress::new(cfg.until, a.quiet || !root, a.trace.as_deref());
     let report = {
         let mut sinks = Sinks {
             trace: trace.as_mut(),
             progress: progress.as_mut(),
+            saver: saver.as_ref(),
         };
-        execute(&scenario, &cfg, &mut sinks)
+        execute(scenario, &cfg, &mut sinks)
     };
     if let Some(p) = &progress {
         p.bar.finish_and_clear();
@@ -360,48 +411,82 @@ pub fn run(a: &RunArgs) -> Result<(), Failure> {
         ))
     };
     if let Some(t) = trace {
-        t.finish().map_err(|e| trace_failed(&e))?;
+        t.writer.finish().map_err(|e| trace_failed(&e))?;
     }
-    let report = report.map_err(|e| match e {
+    let mut report = report.map_err(|e| match e {
         RunError::Output(m) => trace_failed(&m),
         e => run_failure(e),
     })?;
     if !root {
         return interrupted(&interrupt, report.outcome.t);
     }
+    if let Some(c) = from {
+        count_from(&mut report.summary, c);
+    }
     if let Some(p) = &a.final_state {
         write_final_state(p, &report.outcome)?;
     }
-    // with the trace on stdout, the summary goes to stderr
-    let to_stdout = a.trace.as_ref().is_none_or(|p| p.as_os_str() != "-");
-    if a.json || !a.quiet {
-        let summary = if a.json {
-            serde_json::to_string(&report.summary).expect("plain data") + "\n"
-        } else {
-            human_summary(&report.summary)
-        };
-        let written = if to_stdout {
-            std::io::stdout().write_all(summary.as_bytes())
-        } else {
-            std::io::stderr().write_all(summary.as_bytes())
-        };
-        written.map_err(|e| usage(format!("writing the summary failed: {e}")))?;
-    }
+    print_summary(a, &report.summary)?;
     interrupted(&interrupt, report.outcome.t)
 }
 
-/// Where the trace goes: the file at `p`, or stdout for `-`.
-fn trace_file(p: &std::path::Path) -> Result<BufWriter<Box<dyn Write>>, Failure> {
-    if p.as_os_str() == "-" {
-        return Ok(BufWriter::new(Box::new(std::io::stdout())));
+/// The summary of a run taken up from checkpoint `c` counts the events before it, and the
+/// energy at the first run's start.
+fn count_from(summary: &mut RunSummary, c: &Checkpoint) {
+    summary.events = crate::checkpoints::add(c.events, summary.events);
+    let ke = &summary.kinetic_energy;
+    summary.kinetic_energy = KineticEnergy::new(c.initial_energy, ke.end, ke.pocketed);
+}
+
+/// `--checkpoint-every`, checked: a positive time, the whole run by default (a checkpoint at
+/// the end and where an interrupt stops the run); not on the time-step engine.
+fn checkpoint_every(
+    a: &RunArgs,
+    engine: &EngineKind,
+    start: f64,
+    until: f64,
+) -> Result<Option<f64>, Failure> {
+    let Some(path) = &a.checkpoint else {
+        return match a.checkpoint_every {
+            Some(_) => Err(usage("--checkpoint-every: give --checkpoint FILE too")),
+            None => Ok(None),
+        };
+    };
+    if matches!(engine, EngineKind::TimeStep { .. }) {
+        return Err(usage(
+            "--checkpoint: the time-step engine cannot be taken up exactly (its state is its \
+             grid of steps)",
+        ));
     }
-    let file = File::create(p).map_err(|e| {
-        usage(format!(
-            "{}: cannot create the trace file: {e}",
-            p.display()
-        ))
-    })?;
-    Ok(BufWriter::new(Box::new(file)))
+    if path.as_os_str() == "-" {
+        return Err(usage("--checkpoint: give a file (not -)"));
+    }
+    match a.checkpoint_every {
+        Some(t) if !(t.is_finite() && t > 0.0) => Err(usage(format!(
+            "--checkpoint-every: must be a positive time, got {t}"
+        ))),
+        Some(t) => Ok(Some(t)),
+        None => Ok(Some((until - start).max(f64::MIN_POSITIVE))),
+    }
+}
+
+/// Prints the summary (human or `--json`): on stdout, or on stderr when the trace is there.
+fn print_summary(a: &RunArgs, summary: &RunSummary) -> Result<(), Failure> {
+    if !(a.json || !a.quiet) {
+        return Ok(());
+    }
+    let to_stdout = a.trace.as_ref().is_none_or(|p| p.as_os_str() != "-");
+    let text = if a.json {
+        serde_json::to_string(summary).expect("plain data") + "\n"
+    } else {
+        human_summary(summary)
+    };
+    let written = if to_stdout {
+        std::io::stdout().write_all(text.as_bytes())
+    } else {
+        std::io::stderr().write_all(text.as_bytes())
+    };
+    written.map_err(|e| usage(format!("writing the summary failed: {e}")))
 }
 
 /// Writes the final state of `outcome` to `p` as pretty JSON.
@@ -419,16 +504,17 @@ fn write_final_state(
     })
 }
 
-/// Trace and progress, each optional.
-pub struct Sinks<'a, W: std::io::Write> {
-    pub trace: Option<&'a mut TraceWriter<W>>,
+/// Trace, progress and checkpoints, each optional.
+pub struct Sinks<'a> {
+    pub trace: Option<&'a mut Trace>,
     pub progress: Option<&'a mut Progress>,
+    pub saver: Option<&'a Saver>,
 }
 
-impl<W: std::io::Write> Observer for Sinks<'_, W> {
+impl Observer for Sinks<'_> {
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
         if let Some(t) = &mut self.trace {
-            t.on_event(ev, world)?;
+            t.writer.on_event(ev, world)?;
         }
         if let Some(p) = &mut self.progress {
             p.on_event(ev, world)?;
@@ -437,8 +523,14 @@ impl<W: std::io::Write> Observer for Sinks<'_, W> {
     }
 
     fn reads_balls(&self) -> bool {
-        self.trace.as_ref().is_some_and(|t| t.reads_balls())
-            || self.progress.as_ref().is_some_and(|p| p.reads_balls())
+        self.progress.as_ref().is_some_and(|p| p.reads_balls())
+    }
+
+    fn on_checkpoint(&mut self, checkpoint: Checkpoint) -> Result<(), RunError> {
+        match self.saver {
+            Some(s) => s.save(checkpoint, self.trace.as_deref_mut()),
+            None => Ok(()),
+        }
     }
 }
 
