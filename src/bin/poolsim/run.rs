@@ -472,7 +472,7 @@ fn checkpoint_every(
 
 /// Prints the summary (human or `--json`): on stdout, or on stderr when the trace is there.
 fn print_summary(a: &RunArgs, summary: &RunSummary) -> Result<(), Failure> {
-    if !(a.json || !a.quiet) {
+    if !a.json && a.quiet {
         return Ok(());
     }
     let to_stdout = a.trace.as_ref().is_none_or(|p| p.as_os_str() != "-");
