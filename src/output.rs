@@ -2,6 +2,7 @@
 //! digest of the final state, and event counting. Formats are the contracts of DESIGN.md.
 
 use crate::engine::{BallState, Event, Observer, RunError, Table, World};
+use crate::scenario::{BallSpec, CushionSpec, Invalid, PocketSpec, Scenario};
 use serde::Serialize;
 use std::io::Write;
 
@@ -91,6 +92,7 @@ impl Observer for TraceRecorder {
 
 /// One ball in the final state file.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FinalBall {
     /// `Ball-k`.
     pub name: String,
@@ -98,22 +100,32 @@ pub struct FinalBall {
     pub position: [f64; 2],
     /// Velocity at the end time (zero in a pocket).
     pub velocity: [f64; 2],
+    /// Radius.
+    pub radius: f64,
+    /// Mass.
+    pub mass: f64,
     /// The pocket holding it (`Pocket-k`), or null.
     pub pocket: Option<String>,
 }
 
-/// The final state file: `{"t": T, "balls": [...]}`.
+/// The final state file: the end time, every ball, and the table, so that it can start
+/// another run (`poolsim run FILE.json`).
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FinalState {
     /// The end time.
     pub t: f64,
     /// Every ball, `Ball-1` first.
     pub balls: Vec<FinalBall>,
+    /// The cushions, `Cushion-1` first.
+    pub cushions: Vec<CushionSpec>,
+    /// The pockets, `Pocket-1` first.
+    pub pockets: Vec<PocketSpec>,
 }
 
 impl FinalState {
-    /// The final state of balls fixed at time `t`.
-    pub fn new(t: f64, balls: &[BallState]) -> FinalState {
+    /// The final state of balls fixed at time `t` on the table of scenario `s`.
+    pub fn new(t: f64, balls: &[BallState], s: &Scenario) -> FinalState {
         FinalState {
             t,
             balls: balls
@@ -123,11 +135,61 @@ impl FinalState {
                     name: format!("Ball-{}", i + 1),
                     position: b.position(t).into(),
                     velocity: b.velocity().into(),
+                    radius: b.radius,
+                    mass: b.mass,
                     pocket: b.pocket.map(|k| format!("Pocket-{}", k + 1)),
                 })
                 .collect(),
+            cushions: s.cushions.clone(),
+            pockets: s.pockets.clone(),
         }
     }
+
+    /// The scenario that starts where this state ends: its balls at time 0 where they are
+    /// at `t` (balls in pockets stay there), on the same table, to run until `until`.
+    pub fn to_scenario(&self, name: &str, until: f64) -> Result<Scenario, Invalid> {
+        let balls = self
+            .balls
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let pocket = match &b.pocket {
+                    None => None,
+                    Some(p) => {
+                        Some(pocket_index(p, self.pockets.len()).ok_or_else(|| Invalid {
+                            field: format!("balls[{}].pocket", i + 1),
+                            message: format!(
+                                "names {p}, not one of the {} pockets (Pocket-1 ...)",
+                                self.pockets.len()
+                            ),
+                        })?)
+                    }
+                };
+                Ok(BallSpec {
+                    position: b.position.into(),
+                    velocity: b.velocity.into(),
+                    radius: b.radius,
+                    mass: b.mass,
+                    fixed: None,
+                    pocket,
+                })
+            })
+            .collect::<Result<Vec<_>, Invalid>>()?;
+        Ok(Scenario {
+            name: name.to_string(),
+            until,
+            balls,
+            cushions: self.cushions.clone(),
+            pockets: self.pockets.clone(),
+            sectors: None,
+        })
+    }
+}
+
+/// The index (from 0) of pocket `Pocket-k` among `n`.
+fn pocket_index(name: &str, n: usize) -> Option<u32> {
+    let k: u32 = name.strip_prefix("Pocket-")?.parse().ok()?;
+    (k >= 1 && k as usize <= n).then(|| k - 1)
 }
 
 /// A 64-bit FNV-1a hash, in hex, of every ball's final position and velocity bits (and pocket):

@@ -360,10 +360,10 @@ impl Scenario {
                 let lo = sorted.partition_point(|e| e.0 < (y, cx.saturating_sub(1)));
                 let hi = sorted.partition_point(|e| e.0 <= (y, cx.saturating_add(1)));
                 for &(_, j) in &sorted[lo..hi] {
-                    if j <= i {
+                    let bj = &self.balls[j];
+                    if j <= i || bi.pocket.is_some() || bj.pocket.is_some() {
                         continue;
                     }
-                    let bj = &self.balls[j];
                     let sigma = bi.radius + bj.radius;
                     // Touching is allowed (a rack, a cradle); overlap beyond rounding is not.
                     if (bj.position - bi.position).norm2() < sigma * sigma * (1.0 - 1e-12) {
@@ -484,7 +484,13 @@ impl Scenario {
         let (lo, hi) = self.bounds();
         let loops = self.closed_edges();
         self.check_each_winding(loops.as_deref())?;
-        for (i, b) in self.balls.iter().enumerate() {
+        // a ball in a pocket (a state to start from) is where it crossed into it
+        for (i, b) in self
+            .balls
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.pocket.is_none())
+        {
             let p = b.position;
             let field = || format!("ball[{}].position", i + 1);
             if !inside_box(p, lo, hi) {

@@ -93,8 +93,31 @@ pub fn load_from(reader: impl Read, source: &str) -> Result<Scenario, ScenarioEr
                 MAX_SCENARIO_BYTES >> 20
             ),
         )),
+        // no TOML starts with a brace: this is a final state (JSON) to start from
+        Ok(_) if text.trim_start().starts_with('{') => from_final_state(&text, source),
         Ok(_) => parse(&text, source),
     }
+}
+
+/// The scenario that starts where a final state file (`poolsim run --final-state`) ends: its
+/// balls at time 0 where they were at its end, on its table, until [`DEFAULT_UNTIL`].
+fn from_final_state(text: &str, source: &str) -> Result<Scenario, ScenarioError> {
+    let state: crate::output::FinalState =
+        serde_json::from_str(text).map_err(|e| ScenarioError {
+            source: source.to_string(),
+            line: Some(e.line()),
+            field: String::new(),
+            message: format!("not a final state: {e}"),
+        })?;
+    let fail = |e: super::Invalid| ScenarioError {
+        source: source.to_string(),
+        line: None,
+        field: e.field,
+        message: e.message,
+    };
+    let s = state.to_scenario(source, DEFAULT_UNTIL).map_err(fail)?;
+    s.validate().map_err(fail)?;
+    Ok(s)
 }
 
 /// An error reading `source`, before any line of it is known.

@@ -424,7 +424,7 @@ pub fn run_from(
         count_from(&mut report.summary, c);
     }
     if let Some(p) = &a.final_state {
-        write_final_state(p, &report.outcome)?;
+        write_final_state(p, &report.outcome, scenario)?;
     }
     print_summary(a, &report.summary)?;
     interrupted(&interrupt, report.outcome.t)
@@ -493,8 +493,9 @@ fn print_summary(a: &RunArgs, summary: &RunSummary) -> Result<(), Failure> {
 fn write_final_state(
     p: &std::path::Path,
     outcome: &poolsim::engine::Outcome,
+    scenario: &Scenario,
 ) -> Result<(), Failure> {
-    let fs = FinalState::new(outcome.t, &outcome.balls);
+    let fs = FinalState::new(outcome.t, &outcome.balls, scenario);
     let text = serde_json::to_string_pretty(&fs).expect("a final state serializes");
     std::fs::write(p, text + "\n").map_err(|e| {
         usage(format!(
