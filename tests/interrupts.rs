@@ -153,3 +153,41 @@ fn sigint_stops_time_warp_cleanly() {
         "SIGINT",
     );
 }
+
+/// An interrupted run writes its checkpoint where it stopped; taken up from it (on another
+/// engine), it ends as a run that never stopped, its trace continued where it was cut.
+#[test]
+fn an_interrupted_run_is_taken_up_from_its_checkpoint() {
+    let dir = tempfile::tempdir().unwrap();
+    let cp = dir.path().join("cp.json");
+    let cut = run(
+        dir.path(),
+        "cut",
+        &["--until", "1e6", "--checkpoint", cp.to_str().unwrap()],
+        Some(libc::SIGINT),
+    );
+    assert_eq!(cut.code, Some(130), "{}", cut.stderr);
+    let at = cut.summary["interrupted"]["at"].as_f64().unwrap();
+    let checkpoint: Value = serde_json::from_str(&std::fs::read_to_string(&cp).unwrap()).unwrap();
+    assert_eq!(checkpoint["t"].as_f64(), Some(at));
+    let end = format!("{:?}", at + 1.0);
+    let whole = run(dir.path(), "whole", &["--until", &end], None);
+    let out = Command::new(BIN)
+        .current_dir(dir.path())
+        .args(["resume", "cp.json", "--json", "--until", &end])
+        .args(["--engine", "objects", "--sectors", "auto"])
+        .output()
+        .expect("poolsim runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let taken: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        taken["final_state_digest"],
+        whole.summary["final_state_digest"]
+    );
+    let trace = std::fs::read_to_string(dir.path().join("cut.jsonl")).unwrap();
+    assert!(trace == whole.trace, "the trace taken up differs");
+}

@@ -277,3 +277,49 @@ fn bad_checkpoints_and_options_are_refused_with_one_line() {
     );
     assert!(line.contains("--trace and --checkpoint"), "{line}");
 }
+
+/// A final state starts another run, balls in pockets staying there, on every engine alike.
+#[test]
+fn a_final_state_starts_another_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    ok(d, &["run", "pool", "--json", "--final-state", "end.json"]);
+    let end: Value = serde_json::from_str(&read(d, "end.json")).unwrap();
+    let pocketed = |v: &Value| {
+        v["balls"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|b| !b["pocket"].is_null())
+            .count()
+    };
+    assert!(pocketed(&end) > 0, "the break pockets a ball");
+    assert!(end["cushions"].as_array().unwrap().len() >= 4);
+    let mut digests = Vec::new();
+    for engine in [
+        &["--engine", "event-list"][..],
+        &["--engine", "objects"],
+        &["--engine", "time-warp", "--workers", "2"],
+    ] {
+        let args = args(&[
+            &[
+                "run",
+                "end.json",
+                "--json",
+                "--check",
+                "--until",
+                "3",
+                "--final-state",
+                "next.json",
+            ],
+            engine,
+        ]);
+        digests.push(ok(d, &args)["final_state_digest"].clone());
+    }
+    assert!(digests.windows(2).all(|w| w[0] == w[1]), "{digests:?}");
+    let next: Value = serde_json::from_str(&read(d, "next.json")).unwrap();
+    assert!(
+        pocketed(&next) >= pocketed(&end),
+        "pocketed balls stay in their pockets"
+    );
+}
