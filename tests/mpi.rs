@@ -294,3 +294,43 @@ fn a_signal_to_one_rank_stops_them_all_cleanly() {
     assert_eq!(got["final_state_digest"], want["final_state_digest"]);
     assert_eq!(read(&trace), read(&want_trace), "traces differ");
 }
+
+/// Checkpoints across ranks: rank 0 writes the one file, in stretches that end where the run in
+/// one go would pass, and a run taken up from it on ranks ends as the sequential run does.
+#[test]
+fn checkpoints_on_ranks() {
+    let dir = tempfile::tempdir().unwrap();
+    let cp = dir.path().join("cp.json");
+    let cp = cp.to_str().unwrap();
+    let gas = ["run", "gas", "--balls", "400", "--json", "--quiet"];
+    let want = poolsim(None, None, &[&gas[..], &["--until", "4"]].concat());
+    let tw = [
+        "--engine",
+        "time-warp",
+        "--workers",
+        "1",
+        "--sectors",
+        "auto",
+    ];
+    let stretch = [
+        &gas[..],
+        &tw,
+        &[
+            "--until",
+            "2",
+            "--checkpoint",
+            cp,
+            "--checkpoint-every",
+            "0.5",
+        ],
+    ]
+    .concat();
+    poolsim(Some(2), None, &stretch);
+    let taken = poolsim(
+        Some(2),
+        Some(3),
+        &[&["resume", cp, "--json", "--until", "4"][..], &tw].concat(),
+    );
+    assert_eq!(taken["final_state_digest"], want["final_state_digest"]);
+    assert_eq!(taken["events"], want["events"]);
+}
