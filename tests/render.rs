@@ -439,6 +439,7 @@ fn browse(browser: &str, page: &Path, t: &str) -> (serde_json::Value, Vec<String
             "--no-sandbox",
             "--disable-gpu",
             "--disable-background-networking",
+            "--window-size=1280,1000",
             "--enable-logging=stderr",
             "--v=0",
         ])
@@ -533,6 +534,83 @@ fn the_page_in_a_browser_shows_the_trace_s_positions() {
                 .map(|v| v.as_u64().unwrap())
                 .sum();
             assert_eq!(shown, events, "events up to {t}");
+        }
+    }
+}
+
+/// The page's layout in a 1280 x 1000 window, by its geometry: no two labels overlap, every
+/// velocity arrow stays on the table's picture, and the counts line is inside the window; the
+/// 36-ball gas, the break, and 10^4 balls (whose vectors are off by default).
+#[test]
+fn the_page_s_layout_keeps_labels_apart_and_arrows_on_the_table() {
+    let Some(browser) = chromium() else {
+        assert!(
+            std::env::var_os("POOLSIM_REQUIRE_BROWSER").is_none(),
+            "POOLSIM_REQUIRE_BROWSER is set but no headless Chromium was found"
+        );
+        eprintln!("skipped: no headless browser");
+        return;
+    };
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let big = scenario::load(
+        "gas",
+        &Params {
+            balls: Some(10_000),
+            ..Params::default()
+        },
+    )
+    .unwrap();
+    let cases = [
+        ("gas", scenario("gas"), 2.0, 0.5),
+        ("pool", scenario("pool"), 2.0, 0.5),
+        ("gas of 10^4", big, 0.2, 0.1),
+    ];
+    for (name, s, until, frame) in cases {
+        let rec = record(&s, &config(EngineKind::EventList, until, frame)).expect("records");
+        let page = dir.path().join("layout.html");
+        std::fs::write(&page, html::page(&rec)).expect("the page is written");
+        for t in ["0", "1"] {
+            let (state, console) = browse(browser, &page, t);
+            assert!(console.is_empty(), "{name} at {t}: {console:?}");
+            let l = &state["layout"];
+            let rect = |v: &serde_json::Value| -> [f64; 4] {
+                let a = v.as_array().expect("a box");
+                [0, 1, 2, 3].map(|k| a[k].as_f64().unwrap())
+            };
+            let [ww, wh] = [0, 1].map(|k| l["window"][k].as_f64().unwrap());
+            let counts = rect(&l["counts"]);
+            assert!(
+                counts[2] <= ww && counts[3] <= wh,
+                "{name} at {t}: the counts line {counts:?} leaves the {ww} x {wh} window"
+            );
+            let table = rect(&l["table"]);
+            let arrows = l["arrows"].as_array().unwrap();
+            if s.balls.len() > svg::MAX_NAMED_BALLS {
+                assert!(arrows.is_empty(), "{name}: vectors off by default");
+            }
+            for a in arrows {
+                let a = rect(a);
+                let inside = |x: f64, y: f64| {
+                    x >= table[0] - 1.0
+                        && x <= table[2] + 1.0
+                        && y >= table[1] - 1.0
+                        && y <= table[3] + 1.0
+                };
+                assert!(
+                    inside(a[2], a[3]),
+                    "{name} at {t}: arrow {a:?} leaves the table {table:?}"
+                );
+            }
+            let labels: Vec<[f64; 4]> = l["labels"].as_array().unwrap().iter().map(rect).collect();
+            for (i, a) in labels.iter().enumerate() {
+                for b in &labels[i + 1..] {
+                    let apart = a[2] <= b[0] + 0.5
+                        || b[2] <= a[0] + 0.5
+                        || a[3] <= b[1] + 0.5
+                        || b[3] <= a[1] + 0.5;
+                    assert!(apart, "{name} at {t}: labels {a:?} and {b:?} overlap");
+                }
+            }
         }
     }
 }

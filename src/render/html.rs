@@ -34,7 +34,7 @@ h1 { font-size: 18px; margin: 0 0 8px 0; }
 #time { width: 360px; }
 #clock { font-variant-numeric: tabular-nums; min-width: 70px; display: inline-block; }
 #main { display: flex; gap: 16px; align-items: flex-start; flex-wrap: wrap; }
-#stage svg { max-width: 100%; height: auto; border: 1px solid #ccc; background: white; }
+#stage svg { max-width: 100%; max-height: calc(100vh - 96px); width: auto; height: auto; border: 1px solid #ccc; background: white; }
 #panel { font-size: 13px; min-width: 260px; }
 #panel table { border-collapse: collapse; margin-bottom: 12px; }
 #panel td, #panel th { padding: 2px 8px; border-bottom: 1px solid #eee; text-align: left; }
@@ -133,6 +133,7 @@ pub fn data(rec: &Recording) -> Value {
     let view = View::new(scene);
     let table = &scene.table;
     let first = rec.shots.first().map(|s| &s.frame.balls[..]).unwrap_or(&[]);
+    let style = rec.style();
     let balls: Vec<Value> = (0..table.n_balls as usize)
         .map(|i| json!({"name": table.name(i as u32), "r": first.get(i).map_or(0.0, |b| b.radius)}))
         .collect();
@@ -167,6 +168,9 @@ pub fn data(rec: &Recording) -> Value {
             "line": svg::LINE,
             "list_max": svg::LIST_MAX,
             "names_balls": svg::names_balls(scene, &view, first),
+            "vectors": style.vectors,
+            "arrow_time": style.arrow_time,
+            "table_box": [scene.table.lo.x, scene.table.lo.y, scene.table.hi.x, scene.table.hi.y],
             "colours": {
                 "ball": colour::BALL, "vector": colour::VECTOR, "text": colour::TEXT,
                 "sector": colour::SECTOR, "quiet": colour::QUIET,

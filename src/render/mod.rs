@@ -199,6 +199,14 @@ pub struct Recording {
     pub summary: RunSummary,
 }
 
+impl Recording {
+    /// The style of its pictures ([`svg::Style::for_run`], from the first frame's balls).
+    pub fn style(&self) -> svg::Style {
+        let first = self.shots.first().map_or(&[][..], |s| &s.frame.balls[..]);
+        svg::Style::for_run(&self.scene, first)
+    }
+}
+
 /// Records what a run shows: frames with the event counts at their times, and the history.
 struct Recorder {
     counts: EventCounts,

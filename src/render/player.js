@@ -167,7 +167,17 @@
     return lines;
   }
 
-  const style = { vectors: true, labels: true, sectors: D.sectors.length > 0 };
+  const style = { vectors: C.vectors, labels: true, sectors: D.sectors.length > 0 };
+  // As src/render/svg.rs arrow_head: the arrow cut where it leaves the table's box.
+  function arrowHead(x, y, dx, dy) {
+    const [lx, ly, hx, hy] = C.table_box;
+    let s = 1;
+    if (dx > 0 && x + dx > hx) s = Math.min(s, Math.max(0, (hx - x) / dx));
+    else if (dx < 0 && x + dx < lx) s = Math.min(s, Math.max(0, (lx - x) / dx));
+    if (dy > 0 && y + dy > hy) s = Math.min(s, Math.max(0, (hy - y) / dy));
+    else if (dy < 0 && y + dy < ly) s = Math.min(s, Math.max(0, (ly - y) / dy));
+    return [x + dx * s, y + dy * s];
+  }
   let current = null;
 
   function draw(t) {
@@ -189,7 +199,8 @@
       balls.forEach((b, i) => {
         if (b.pocket !== null || (b.vx === 0 && b.vy === 0)) return;
         const [x, y] = px(b.x, b.y);
-        const [hx, hy] = px(b.x + b.vx, b.y + b.vy);
+        const head = arrowHead(b.x, b.y, b.vx * C.arrow_time, b.vy * C.arrow_time);
+        const [hx, hy] = px(head[0], head[1]);
         s += '<line class="velocity" data-ball="' + D.balls[i].name + '" x1="' + n(x) + '" y1="' + n(y) + '" x2="' +
           n(hx) + '" y2="' + n(hy) + '" stroke="' + C.colours.vector +
           '" stroke-width="1.5" marker-end="url(#poolsim-arrow)"/>';
@@ -268,6 +279,22 @@
       exact: !!H,
     };
   }
+  // Where things landed on the screen, in CSS pixels (for the headless tests of the layout).
+  function layout() {
+    const box = (e) => { const r = e.getBoundingClientRect(); return [r.left, r.top, r.right, r.bottom]; };
+    const [x0, y0] = px(C.table_box[0], C.table_box[3]);
+    const [x1, y1] = px(C.table_box[2], C.table_box[1]);
+    const m = svg.getScreenCTM();
+    const screen = (x, y) => { const p = svg.createSVGPoint(); p.x = x; p.y = y; const q = p.matrixTransform(m); return [q.x, q.y]; };
+    return {
+      window: [window.innerWidth, window.innerHeight],
+      table: screen(x0, y0).concat(screen(x1, y1)),
+      labels: Array.from(svg.querySelectorAll('text.label, text.pocket-label')).map(box),
+      arrows: Array.from(svg.querySelectorAll('line.velocity')).map((l) =>
+        screen(+l.getAttribute('x1'), +l.getAttribute('y1')).concat(screen(+l.getAttribute('x2'), +l.getAttribute('y2')))),
+      counts: box(svg.querySelector('text.counts')),
+    };
+  }
   function tick(now) {
     if (!playing) return;
     if (last !== null) {
@@ -307,6 +334,7 @@
   }
   ['show-sectors', 'show-vectors', 'show-labels'].forEach((id) => $(id).addEventListener('change', toggles));
   if (D.sectors.length === 0) { $('show-sectors').checked = false; $('show-sectors').disabled = true; }
+  $('show-vectors').checked = C.vectors;
   document.addEventListener('keydown', (e) => {
     if (e.target && e.target.tagName === 'SELECT') return;
     if (e.key === ' ') { e.preventDefault(); playing ? pause() : play(); }
@@ -328,7 +356,7 @@
     seek(q.get('t'));
     if (q.get('dump') === '1') {
       const pre = $('poolsim-state');
-      pre.textContent = JSON.stringify(state());
+      pre.textContent = JSON.stringify(Object.assign(state(), { layout: layout() }));
       pre.hidden = false;
     }
   } else {

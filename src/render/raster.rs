@@ -158,7 +158,7 @@ fn gif_error(e: gif::EncodingError) -> RasterError {
 /// Writes every frame of `rec` into the folder `dir` as SVG and PNG; returns one line that says
 /// what was written.
 pub fn write_folder(rec: &Recording, dir: &Path, r: &Rasterizer) -> Result<String, RenderError> {
-    let style = svg::Style::default();
+    let style = rec.style();
     std::fs::create_dir_all(dir).map_err(io_error(dir))?;
     let count = rec.shots.len();
     for (k, shot) in rec.shots.iter().enumerate() {
@@ -182,7 +182,7 @@ pub fn write_folder(rec: &Recording, dir: &Path, r: &Rasterizer) -> Result<Strin
 /// Writes the frames of `rec` as one animated GIF at `path`; returns one line that says what was
 /// written.
 pub fn write_gif(rec: &Recording, path: &Path, r: &Rasterizer) -> Result<String, RenderError> {
-    let style = svg::Style::default();
+    let style = rec.style();
     let mut file = Some(std::fs::File::create(path).map_err(io_error(path))?);
     let mut gif: Option<GifWriter<std::io::BufWriter<std::fs::File>>> = None;
     for shot in &rec.shots {

@@ -57,7 +57,7 @@ pub mod colour {
 }
 
 /// Which optional parts a picture shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Style {
     /// Velocity vectors.
     pub vectors: bool,
@@ -65,6 +65,9 @@ pub struct Style {
     pub labels: bool,
     /// Sector outlines and labels (when the scene has sectors).
     pub sectors: bool,
+    /// The time a velocity arrow spans: each arrow runs from the ball to where it would be this
+    /// much later (cut at the table's edge).
+    pub arrow_time: f64,
 }
 
 impl Default for Style {
@@ -73,8 +76,53 @@ impl Default for Style {
             vectors: true,
             labels: true,
             sectors: true,
+            arrow_time: 1.0,
         }
     }
+}
+
+/// The longest velocity arrow, as a share of the table's shorter side.
+const ARROW_SHARE: f64 = 0.3;
+
+impl Style {
+    /// The style of a run's pictures: vectors only up to [`MAX_NAMED_BALLS`] balls (beyond,
+    /// they cover the table), each arrow spanning one time unit, or less where the fastest
+    /// ball of `balls` (the first frame's) would otherwise run past [`ARROW_SHARE`] of the
+    /// table's shorter side.
+    pub fn for_run(scene: &Scene, balls: &[BallState]) -> Style {
+        let side = (scene.table.hi - scene.table.lo)
+            .x
+            .min((scene.table.hi - scene.table.lo).y);
+        let fastest = balls
+            .iter()
+            .map(|b| b.velocity().norm())
+            .fold(0.0, f64::max);
+        let arrow_time = if fastest > 0.0 && side.is_finite() {
+            (ARROW_SHARE * side / fastest).min(1.0)
+        } else {
+            1.0
+        };
+        Style {
+            vectors: balls.len() <= MAX_NAMED_BALLS,
+            arrow_time,
+            ..Style::default()
+        }
+    }
+}
+
+/// Where an arrow from `p` (on the table) towards `head` ends: at `head`, or where it leaves
+/// the table's box from `lo` to `hi`.
+pub fn arrow_head(p: Vec2, head: Vec2, lo: Vec2, hi: Vec2) -> Vec2 {
+    let d = head - p;
+    let mut s: f64 = 1.0;
+    for (x, dx, a, b) in [(p.x, d.x, lo.x, hi.x), (p.y, d.y, lo.y, hi.y)] {
+        if dx > 0.0 && x + dx > b {
+            s = s.min(((b - x) / dx).max(0.0));
+        } else if dx < 0.0 && x + dx < a {
+            s = s.min(((a - x) / dx).max(0.0));
+        }
+    }
+    p + s * d
 }
 
 /// How table coordinates map to pixels.
@@ -470,7 +518,7 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
     };
     ball_circles(&mut out, scene, view, balls);
     if style.vectors {
-        velocity_arrows(&mut out, scene, view, balls);
+        velocity_arrows(&mut out, scene, view, balls, style.arrow_time);
     }
     if style.labels {
         if names_balls(scene, view, balls) {
@@ -512,15 +560,23 @@ fn ball_circles(out: &mut String, scene: &Scene, view: &View, balls: &[BallState
     }
 }
 
-/// Every moving ball's velocity, as an arrow one time unit long.
-fn velocity_arrows(out: &mut String, scene: &Scene, view: &View, balls: &[BallState]) {
+/// Every moving ball's velocity, as an arrow `arrow_time` long, cut at the table's edge.
+fn velocity_arrows(
+    out: &mut String,
+    scene: &Scene,
+    view: &View,
+    balls: &[BallState],
+    arrow_time: f64,
+) {
+    let (lo, hi) = (scene.table.lo, scene.table.hi);
     for (i, b) in balls.iter().enumerate() {
         let v = b.velocity();
         if b.pocket.is_some() || v == Vec2::ZERO {
             continue;
         }
-        let (x, y) = view.px(b.traj.position);
-        let (hx, hy) = view.px(b.traj.position + v);
+        let p = b.traj.position;
+        let (x, y) = view.px(p);
+        let (hx, hy) = view.px(arrow_head(p, p + arrow_time * v, lo, hi));
         let _ = write!(
             out,
             r#"<line class="velocity" data-ball="{}" x1="{}" y1="{}" x2="{}" y2="{}" stroke="{}" stroke-width="1.5" marker-end="url(#poolsim-arrow)"/>"#,
