@@ -106,6 +106,12 @@ pub struct FinalBall {
     pub mass: f64,
     /// The pocket holding it (`Pocket-k`), or null.
     pub pocket: Option<String>,
+    /// Its colour in pictures, if the scenario gave one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<String>,
+    /// Its label in pictures, if the scenario gave one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
 }
 
 /// The final state file: the end time, every ball, and the table, so that it can start
@@ -138,6 +144,8 @@ impl FinalState {
                     radius: b.radius,
                     mass: b.mass,
                     pocket: b.pocket.map(|k| format!("Pocket-{}", k + 1)),
+                    colour: s.balls.get(i).and_then(|b| b.colour.clone()),
+                    label: s.balls.get(i).and_then(|b| b.label.clone()),
                 })
                 .collect(),
             cushions: s.cushions.clone(),
@@ -172,6 +180,8 @@ impl FinalState {
                     mass: b.mass,
                     fixed: None,
                     pocket,
+                    colour: b.colour.clone(),
+                    label: b.label.clone(),
                 })
             })
             .collect::<Result<Vec<_>, Invalid>>()?;

@@ -401,12 +401,17 @@ fn run_with_checkpoints(
             *all += more;
         }
         outcome.events = events;
-        let Some(balls) = engine.balls_to_take_up() else {
+        let Some(mut balls) = engine.balls_to_take_up() else {
             return Err(RunError::Input(format!(
                 "--checkpoint: the {} engine cannot be taken up exactly",
                 cfg.engine.name()
             )));
         };
+        // the engines hold physics alone: the balls keep their looks from the scenario
+        for (b, spec) in balls.iter_mut().zip(&scenario.balls) {
+            b.colour.clone_from(&spec.colour);
+            b.label.clone_from(&spec.label);
+        }
         obs.on_checkpoint(Checkpoint {
             format: crate::checkpoint::FORMAT.into(),
             version: crate::checkpoint::VERSION,

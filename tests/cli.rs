@@ -470,15 +470,41 @@ fn zero_length_cushion_is_refused() {
 #[test]
 fn unknown_key_is_named() {
     let dir = tempfile::tempdir().unwrap();
-    let body = edited("radius = 20.0", "radius = 20.0\ncolour = \"red\"");
+    let body = edited("radius = 20.0", "radius = 20.0\nspin = 3.0");
     let line = bad_file(
         dir.path(),
         "unknown.toml",
         &body,
+        "spin = 3.0",
+        "ball[2].spin",
+    );
+    assert!(line.contains("unknown field"), "{line}");
+}
+
+/// A ball's colour and label are for pictures: a colour is #rrggbb, a label at most 8
+/// characters; anything else is named with its line.
+#[test]
+fn ball_colours_and_labels_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = edited(
+        "radius = 20.0",
+        "radius = 20.0\ncolour = \"#1f4fb4\"\nlabel = \"2\"",
+    );
+    let path = dir.path().join("good.toml");
+    std::fs::write(&path, &good).unwrap();
+    success_json(&["run", path.to_str().unwrap(), "--json"]);
+    let body = edited("radius = 20.0", "radius = 20.0\ncolour = \"red\"");
+    let line = bad_file(
+        dir.path(),
+        "colour.toml",
+        &body,
         "colour = \"red\"",
         "ball[2].colour",
     );
-    assert!(line.contains("unknown field"), "{line}");
+    assert!(line.contains("#rrggbb"), "{line}");
+    let body = edited("radius = 20.0", "radius = 20.0\nlabel = \"a long label\"");
+    let line = bad_file(dir.path(), "label.toml", &body, "label = ", "ball[2].label");
+    assert!(line.contains("at most 8"), "{line}");
 }
 
 #[test]

@@ -24,6 +24,8 @@ fn scenario(name: &str, centres: &[Vec2], radius: f64, speed: f64, (w, h): (f64,
             mass: 1.0,
             fixed: None,
             pocket: None,
+            colour: None,
+            label: None,
         })
         .collect();
     let c = |a: (f64, f64), b: (f64, f64)| CushionSpec {
@@ -100,6 +102,8 @@ fn grains_and_a_boulder(side: f64) -> Scenario {
         mass: 1.0,
         fixed: None,
         pocket: None,
+        colour: None,
+        label: None,
     });
     s.until = 3.0;
     s

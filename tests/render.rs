@@ -614,3 +614,18 @@ fn the_page_s_layout_keeps_labels_apart_and_arrows_on_the_table() {
         }
     }
 }
+
+/// The break's balls in their colours with their numbers on white discs; the cue ball plain.
+#[test]
+fn pool_balls_are_drawn_in_their_colours_with_their_numbers() {
+    let rec = record(&scenario("pool"), &config(EngineKind::EventList, 0.0, 1.0)).expect("records");
+    let svg = svg::frame(&rec.scene, &rec.shots[0], &rec.style());
+    // the 8 in the middle of the third row: Ball-6
+    let eight = elements(&svg, "circle", "data-ball=\"Ball-6\"");
+    assert!(eight[0].contains("fill=\"#111111\""), "{}", eight[0]);
+    assert_eq!(text_block(&svg, "label ball-label", "8"), ["8"]);
+    let cue = elements(&svg, "circle", "data-ball=\"Ball-1\"");
+    assert!(cue[0].contains("fill=\"#f4f1e6\""), "{}", cue[0]);
+    assert!(!svg.contains(">Ball-1<"), "the cue ball carries no text");
+    assert_eq!(elements(&svg, "circle", "class=\"ball-disc\"").len(), 15);
+}

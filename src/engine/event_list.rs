@@ -749,6 +749,8 @@ impl EventList {
                     mass: own.mass,
                     fixed: Some(own.fixed_at.clone()),
                     pocket: self.pocket[i],
+                    colour: None,
+                    label: None,
                 }
             })
             .collect()

@@ -788,6 +788,8 @@ mod tests {
             mass: 1.0,
             fixed: None,
             pocket: None,
+            colour: None,
+            label: None,
         };
         Table::new(&Scenario {
             name: "grid".to_string(),

@@ -234,6 +234,8 @@ where
                 mass: b.mass,
                 fixed: Some(b.fixed.clone()),
                 pocket: b.pocket,
+                colour: None,
+                label: None,
             }
         })
         .collect()

@@ -135,7 +135,15 @@ pub fn data(rec: &Recording) -> Value {
     let first = rec.shots.first().map(|s| &s.frame.balls[..]).unwrap_or(&[]);
     let style = rec.style();
     let balls: Vec<Value> = (0..table.n_balls as usize)
-        .map(|i| json!({"name": table.name(i as u32), "r": first.get(i).map_or(0.0, |b| b.radius)}))
+        .map(|i| {
+            let look = scene.looks.get(i).cloned().unwrap_or_default();
+            json!({
+                "name": table.name(i as u32),
+                "r": first.get(i).map_or(0.0, |b| b.radius),
+                "colour": look.colour,
+                "label": look.label,
+            })
+        })
         .collect();
     let pocket_names: Vec<String> = (0..table.pockets.len() as u32)
         .map(|k| table.name(table.fixed_id(Fixed::Pocket(k))))

@@ -93,6 +93,17 @@ pub struct Scene {
     pub table: Table,
     /// The sectors drawn, if any.
     pub sectors: Option<Layout>,
+    /// How each ball looks: the scenario's colours and labels (a pool ball's number).
+    pub looks: Vec<Look>,
+}
+
+/// How a ball looks in pictures.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Look {
+    /// Its colour (`#rrggbb`), or the default.
+    pub colour: Option<String>,
+    /// What is written on it in place of its name (nothing when empty).
+    pub label: Option<String>,
 }
 
 impl Scene {
@@ -102,6 +113,14 @@ impl Scene {
             name: scenario.name.clone(),
             table: Table::new(scenario),
             sectors,
+            looks: scenario
+                .balls
+                .iter()
+                .map(|b| Look {
+                    colour: b.colour.clone(),
+                    label: b.label.clone(),
+                })
+                .collect(),
         }
     }
 

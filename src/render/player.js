@@ -193,7 +193,12 @@
       if (b.pocket !== null) return;
       const [x, y] = px(b.x, b.y);
       s += '<circle class="ball" data-ball="' + D.balls[i].name + '" cx="' + n(x) + '" cy="' + n(y) + '" r="' +
-        n(D.balls[i].r * V.scale) + '" fill="' + C.colours.ball + '" stroke="black" stroke-width="1.5"/>';
+        n(D.balls[i].r * V.scale) + '" fill="' + (D.balls[i].colour || C.colours.ball) + '" stroke="black" stroke-width="1.5"/>';
+      // a label (a pool ball's number) sits on a white disc, readable on any colour
+      if (D.balls[i].label) {
+        s += '<circle class="ball-disc" cx="' + n(x) + '" cy="' + n(y) + '" r="' + n(0.55 * D.balls[i].r * V.scale) +
+          '" fill="white"/>';
+      }
     });
     if (style.vectors) {
       balls.forEach((b, i) => {
@@ -209,9 +214,10 @@
     if (style.labels) {
       if (C.names_balls) {
         balls.forEach((b, i) => {
-          if (b.pocket !== null) return;
+          if (b.pocket !== null || D.balls[i].label === '') return;
           const [x, y] = px(b.x, b.y);
-          const lines = [D.balls[i].name].concat(inSectors[i].map((k) => D.sectors[k].name));
+          const first = D.balls[i].label === null || D.balls[i].label === undefined ? D.balls[i].name : D.balls[i].label;
+          const lines = [first].concat(inSectors[i].map((k) => D.sectors[k].name));
           s += textBlock({ x: x, y: y, h: 'middle', v: 'center' }, lines, 'label ball-label', C.colours.text,
             ballFont(D.balls[i].r * V.scale));
         });

@@ -87,7 +87,7 @@ const ARROW_SHARE: f64 = 0.3;
 impl Style {
     /// The style of a run's pictures: vectors only up to [`MAX_NAMED_BALLS`] balls (beyond,
     /// they cover the table), each arrow spanning one time unit, or less where the fastest
-    /// ball of `balls` (the first frame's) would otherwise run past [`ARROW_SHARE`] of the
+    /// ball of `balls` (the first frame's) would otherwise run past 30 % of the
     /// table's shorter side.
     pub fn for_run(scene: &Scene, balls: &[BallState]) -> Style {
         let side = (scene.table.hi - scene.table.lo)
@@ -548,6 +548,10 @@ fn ball_circles(out: &mut String, scene: &Scene, view: &View, balls: &[BallState
             continue;
         }
         let (x, y) = view.px(b.traj.position);
+        let look = scene.looks.get(i);
+        let fill = look
+            .and_then(|l| l.colour.as_deref())
+            .unwrap_or(colour::BALL);
         let _ = write!(
             out,
             r#"<circle class="ball" data-ball="{}" cx="{}" cy="{}" r="{}" fill="{}" stroke="black" stroke-width="1.5"/>"#,
@@ -555,8 +559,21 @@ fn ball_circles(out: &mut String, scene: &Scene, view: &View, balls: &[BallState
             n(x),
             n(y),
             n(b.radius * view.scale),
-            colour::BALL
+            fill
         );
+        // a label (a pool ball's number) sits on a white disc, readable on any colour
+        if look
+            .and_then(|l| l.label.as_deref())
+            .is_some_and(|l| !l.is_empty())
+        {
+            let _ = write!(
+                out,
+                r#"<circle class="ball-disc" cx="{}" cy="{}" r="{}" fill="white"/>"#,
+                n(x),
+                n(y),
+                n(0.55 * b.radius * view.scale)
+            );
+        }
     }
 }
 
@@ -603,7 +620,11 @@ fn ball_labels(
             continue;
         }
         let (x, y) = view.px(b.traj.position);
-        let mut lines = vec![scene.table.name(i as u32)];
+        let label = scene.looks.get(i).and_then(|l| l.label.clone());
+        if label.as_deref() == Some("") {
+            continue;
+        }
+        let mut lines = vec![label.unwrap_or_else(|| scene.table.name(i as u32))];
         lines.extend(
             in_sectors[i]
                 .iter()

@@ -260,6 +260,8 @@ fn ball(x: f64, y: f64, vx: f64, vy: f64, radius: f64) -> BallSpec {
         mass: 1.0,
         fixed: None,
         pocket: None,
+        colour: None,
+        label: None,
     }
 }
 
@@ -435,6 +437,8 @@ fn gas(p: &Params) -> Result<Scenario, Invalid> {
             mass: 1.0,
             fixed: None,
             pocket: None,
+            colour: None,
+            label: None,
         })
         .collect();
     Ok(Scenario {
@@ -463,6 +467,8 @@ fn reversal(p: &Params) -> Result<Scenario, Invalid> {
                 mass: 1.0,
                 fixed: None,
                 pocket: None,
+                colour: None,
+                label: None,
             });
         }
     }
@@ -483,6 +489,19 @@ fn reversal(p: &Params) -> Result<Scenario, Invalid> {
 /// The six cushions fill the sides between them, so a pocket's corners stand at its jaws. Sides
 /// and pockets run clockwise from the left cushion. Ball-1, the cue ball, leaves (25, 25) at
 /// speed 400 along +x into a touching triangle of Ball-2..Ball-16 whose apex is at (75, 25).
+/// The cue ball's colour.
+const CUE: &str = "#f4f1e6";
+
+/// The colours of pool balls 1 to 8 (9 to 15 repeat 1 to 7, striped on a real table): yellow,
+/// blue, red, purple, orange, green, maroon, black.
+const POOL_COLOURS: [&str; 8] = [
+    "#f2c318", "#1f4fb4", "#d0312d", "#5b2a86", "#ef7d1a", "#1f7a3a", "#7a1f2b", "#111111",
+];
+
+/// The numbers of the racked balls, apex first, row by row: the 8 in the middle of the third
+/// row, a solid and a stripe at the back corners.
+const RACK: [usize; 15] = [1, 9, 2, 10, 8, 3, 11, 7, 14, 4, 5, 13, 15, 6, 12];
+
 fn pool(p: &Params) -> Result<Scenario, Invalid> {
     allow(p, "pool", &[])?;
     const W: f64 = 100.0;
@@ -508,13 +527,21 @@ fn pool(p: &Params) -> Result<Scenario, Invalid> {
         pocket(v(mid + S, 0.0), v(mid - S, 0.0)),
         pocket(v(C, 0.0), v(0.0, C)),
     ];
-    let mut balls = vec![ball(25.0, 25.0, 400.0, 0.0, R)];
+    let mut cue = ball(25.0, 25.0, 400.0, 0.0, R);
+    cue.colour = Some(CUE.into());
+    cue.label = Some(String::new());
+    let mut balls = vec![cue];
     let row_step = R * 3f64.sqrt();
+    let mut numbers = RACK.iter();
     for i in 0..5 {
         for j in 0..=i {
             let x = 75.0 + i as f64 * row_step;
             let y = 25.0 + (j as f64 - i as f64 / 2.0) * 2.0 * R;
-            balls.push(ball(x, y, 0.0, 0.0, R));
+            let mut b = ball(x, y, 0.0, 0.0, R);
+            let k = *numbers.next().expect("fifteen numbers");
+            b.colour = Some(POOL_COLOURS[(k - 1) % 8].into());
+            b.label = Some(k.to_string());
+            balls.push(b);
         }
     }
     Ok(Scenario {

@@ -39,6 +39,13 @@ pub struct BallSpec {
     /// then where it crossed into it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pocket: Option<u32>,
+    /// Its colour in pictures (`#rrggbb`); the default ball colour when `None`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour: Option<String>,
+    /// What pictures write on it (a pool ball's number, at most 8 characters) in place of its
+    /// name; nothing for an empty label.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
 }
 
 impl BallSpec {
@@ -144,6 +151,28 @@ pub struct Invalid {
 
 fn invalid(field: String, message: String) -> Invalid {
     Invalid { field, message }
+}
+
+/// A ball's colour is `#rrggbb`; its label at most 8 characters, none of them a control.
+fn check_look(f: &str, b: &BallSpec) -> Result<(), Invalid> {
+    if let Some(c) = &b.colour {
+        let hex = c.strip_prefix('#').filter(|h| h.len() == 6);
+        if !hex.is_some_and(|h| h.chars().all(|d| d.is_ascii_hexdigit())) {
+            return Err(invalid(
+                format!("{f}.colour"),
+                format!("must be #rrggbb (six hex digits), got \"{c}\""),
+            ));
+        }
+    }
+    if let Some(l) = &b.label {
+        if l.chars().count() > 8 || l.chars().any(char::is_control) {
+            return Err(invalid(
+                format!("{f}.label"),
+                format!("must be at most 8 printable characters, got {l:?}"),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn check_finite(field: &str, v: f64) -> Result<(), Invalid> {
@@ -311,10 +340,11 @@ impl Scenario {
                 && b.radius > 0.0
                 && b.mass.is_finite()
                 && b.mass > 0.0;
-            if sound {
+            if sound && b.colour.is_none() && b.label.is_none() {
                 continue; // names a field only to blame it: a gas has 10^5 balls and more
             }
             let f = format!("ball[{}]", i + 1);
+            check_look(&f, b)?;
             check_vec(&format!("{f}.position"), b.position)?;
             check_vec(&format!("{f}.velocity"), b.velocity)?;
             if !b.velocity.norm2().is_finite() {

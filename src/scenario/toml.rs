@@ -161,6 +161,8 @@ struct RawBall {
     velocity: Option<Spanned<Pair<f64>>>,
     radius: Spanned<f64>,
     mass: Option<Spanned<f64>>,
+    colour: Option<Spanned<String>>,
+    label: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -265,6 +267,8 @@ impl RawFile {
                     mass: opt(&b.mass, 1.0),
                     fixed: None,
                     pocket: None,
+                    colour: b.colour.as_ref().map(|c| c.get_ref().clone()),
+                    label: b.label.as_ref().map(|l| l.get_ref().clone()),
                 }
             })
             .collect();
@@ -367,6 +371,8 @@ impl RawFile {
                         Some("velocity") => b.velocity.as_ref().map(span),
                         Some("radius") => Some(span(&b.radius)),
                         Some("mass") => b.mass.as_ref().map(span),
+                        Some("colour") => b.colour.as_ref().map(span),
+                        Some("label") => b.label.as_ref().map(span),
                         _ => None,
                     };
                     s.or_else(|| Some(e.span()))
@@ -692,6 +698,8 @@ grid = [2, 3]
                 mass: 1.0,
                 fixed: None,
                 pocket: None,
+                colour: None,
+                label: None,
             }
         );
         assert_eq!(s.balls[1].velocity, Vec2::ZERO);

@@ -89,6 +89,8 @@ pub fn random_scenario() -> impl Strategy<Value = Scenario> {
                         mass: rng.gen_range(0.5..3.0),
                         fixed: None,
                         pocket: None,
+                        colour: None,
+                        label: None,
                     });
                 }
             }
