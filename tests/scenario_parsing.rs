@@ -219,6 +219,12 @@ fn builtins_survive_a_round_trip_through_toml() {
                 "[[ball]]\nposition = [{:?}, {:?}]\nvelocity = [{:?}, {:?}]\nradius = {:?}\nmass = {:?}\n",
                 b.position.x, b.position.y, b.velocity.x, b.velocity.y, b.radius, b.mass
             );
+            if let Some(c) = &b.colour {
+                text += &format!("colour = {c:?}\n");
+            }
+            if let Some(l) = &b.label {
+                text += &format!("label = {l:?}\n");
+            }
         }
         for c in &s.cushions {
             text += &format!(

@@ -844,8 +844,8 @@ grid = [2, 3]
 
     #[test]
     fn unknown_key() {
-        let e = fails(&with_line(8, "colour = 3"));
-        assert_error(&e, 8, "ball[1].colour", "unknown field `colour`");
+        let e = fails(&with_line(8, "spin = 3"));
+        assert_error(&e, 8, "ball[1].spin", "unknown field `spin`");
         let e = fails(&with_line(3, "speed = 3"));
         assert_error(&e, 3, "run.speed", "unknown field `speed`");
         let e = fails(&with_line(35, "[table]"));
