@@ -540,7 +540,8 @@ fn the_page_in_a_browser_shows_the_trace_s_positions() {
 
 /// The page's layout in a 1280 x 1000 window, by its geometry: no two labels overlap, every
 /// velocity arrow stays on the table's picture, and the counts line is inside the window; the
-/// 36-ball gas, the break, and 10^4 balls (whose vectors are off by default).
+/// 36-ball gas, plain and on sectors (a sector's list that would cover a name goes to hover),
+/// the break, and 10^4 balls (whose vectors are off by default).
 #[test]
 fn the_page_s_layout_keeps_labels_apart_and_arrows_on_the_table() {
     let Some(browser) = chromium() else {
@@ -561,12 +562,21 @@ fn the_page_s_layout_keeps_labels_apart_and_arrows_on_the_table() {
     )
     .unwrap();
     let cases = [
-        ("gas", scenario("gas"), 2.0, 0.5),
-        ("pool", scenario("pool"), 2.0, 0.5),
-        ("gas of 10^4", big, 0.2, 0.1),
+        ("gas", scenario("gas"), 2.0, 0.5, None),
+        (
+            "gas on 2 x 2 sectors",
+            scenario("gas"),
+            2.0,
+            0.5,
+            Some(SectorChoice::Grid(2, 2)),
+        ),
+        ("pool", scenario("pool"), 2.0, 0.5, None),
+        ("gas of 10^4", big, 0.2, 0.1, None),
     ];
-    for (name, s, until, frame) in cases {
-        let rec = record(&s, &config(EngineKind::EventList, until, frame)).expect("records");
+    for (name, s, until, frame, sectors) in cases {
+        let mut cfg = config(EngineKind::EventList, until, frame);
+        cfg.sectors = sectors;
+        let rec = record(&s, &cfg).expect("records");
         let page = dir.path().join("layout.html");
         std::fs::write(&page, html::page(&rec)).expect("the page is written");
         for t in ["0", "1"] {

@@ -240,8 +240,35 @@
     s += textBlock({ x: 12, y: V.height - 8, h: 'start', v: 'up' }, countsLines(t, ev, msg), 'counts',
       C.colours.quiet, 11);
     dyn.innerHTML = s;
+    unclutter();
     current = { t: t, balls: balls, events: ev, messages: msg };
     showCounts(ev, msg);
+  }
+
+  // A sector's label that would cover a ball's name shows the sector's name alone, or, if even
+  // that would, nothing: its name and list then show on hover over the sector (the page
+  // measures its text; SVG and PNG frames keep the plates' lists).
+  function unclutter() {
+    const boxes = (sel) => Array.from(dyn.querySelectorAll(sel)).map((e) => e.getBBox());
+    const taken = boxes('text.ball-label');
+    const meets = (a, b) => a.x < b.x + b.width && b.x < a.x + a.width && a.y < b.y + b.height && b.y < a.y + a.height;
+    const free = (box) => !taken.some((b) => meets(box, b));
+    const outlines = svg.querySelectorAll('.sector');
+    Array.from(dyn.querySelectorAll('text.sector-label')).forEach((e, k) => {
+      const stale = outlines[k] && outlines[k].querySelector('title');
+      if (stale) stale.remove();
+      if (free(e.getBBox())) { taken.push(e.getBBox()); return; }
+      const spans = Array.from(e.querySelectorAll('tspan'));
+      const text = spans.map((t) => t.textContent).join('\n');
+      spans.slice(1).forEach((t) => t.remove());
+      if (free(e.getBBox())) taken.push(e.getBBox()); else e.remove();
+      const outline = outlines[k];
+      if (outline) {
+        let title = outline.querySelector('title');
+        if (!title) { title = document.createElementNS(svg.namespaceURI, 'title'); outline.appendChild(title); }
+        title.textContent = text;
+      }
+    });
   }
 
   // ---- the side panel -----------------------------------------------------------------------
