@@ -393,6 +393,11 @@ fn run_with_checkpoints(
     obs: &mut dyn Observer,
 ) -> Result<Outcome, RunError> {
     let every = cfg.checkpoint_every.expect("checkpoints asked for");
+    if matches!(cfg.engine, EngineKind::TimeStep { .. }) {
+        return Err(RunError::Input(
+            "--checkpoint: the time-step engine cannot be taken up exactly".into(),
+        ));
+    }
     let mut events = EventCounts::default();
     for k in 1u64.. {
         let next = (cfg.span.start + k as f64 * every).min(cfg.until);
@@ -401,12 +406,9 @@ fn run_with_checkpoints(
             *all += more;
         }
         outcome.events = events;
-        let Some(mut balls) = engine.balls_to_take_up() else {
-            return Err(RunError::Input(format!(
-                "--checkpoint: the {} engine cannot be taken up exactly",
-                cfg.engine.name()
-            )));
-        };
+        let mut balls = engine
+            .balls_to_take_up()
+            .expect("every engine but the time-step one is taken up");
         // the engines hold physics alone: the balls keep their looks from the scenario
         for (b, spec) in balls.iter_mut().zip(&scenario.balls) {
             b.colour.clone_from(&spec.colour);
@@ -418,9 +420,14 @@ fn run_with_checkpoints(
             t: outcome.t,
             until: cfg.until,
             engine: cfg.engine.name().into(),
+            // the table alone is copied: the balls are the engine's
             scenario: Scenario {
+                name: scenario.name.clone(),
+                until: scenario.until,
                 balls,
-                ..scenario.clone()
+                cushions: scenario.cushions.clone(),
+                pockets: scenario.pockets.clone(),
+                sectors: scenario.sectors.clone(),
             },
             events: EventTotals::from(&events),
             initial_energy,

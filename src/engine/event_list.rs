@@ -734,7 +734,6 @@ impl EventList {
         obs.on_event(&ev, self)
     }
 
-    /// Every ball's state fixed at time `t` (not before the last event).
     /// Every ball as a run that takes this one up must start it: its trajectory as last fixed,
     /// with the key that fixed it, and its pocket.
     pub fn balls_to_take_up(&self) -> Vec<BallSpec> {
@@ -742,21 +741,18 @@ impl EventList {
             .map(|i| {
                 let (slot, own) = (&self.slots[i], &self.own[i]);
                 debug_assert_eq!(slot.traj.t0, own.fixed_at.t, "fixed when it turned");
-                BallSpec {
-                    position: slot.traj.position,
-                    velocity: slot.traj.velocity,
-                    radius: slot.radius,
-                    mass: own.mass,
-                    fixed: Some(own.fixed_at.clone()),
-                    pocket: self.pocket[i],
-                    colour: None,
-                    label: None,
-                }
+                BallSpec::taken_up(
+                    &slot.traj,
+                    slot.radius,
+                    own.mass,
+                    &own.fixed_at,
+                    self.pocket[i],
+                )
             })
             .collect()
     }
 
-    /// Every ball's state at time `t`.
+    /// Every ball's state fixed at time `t` (not before the last event).
     pub fn state_at(&self, t: f64) -> Vec<BallState> {
         (0..self.slots.len() as u32)
             .map(|i| {

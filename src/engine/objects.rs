@@ -227,16 +227,7 @@ where
         .iter()
         .map(|s| {
             let b = s.ball_info();
-            BallSpec {
-                position: b.traj.position,
-                velocity: b.traj.velocity,
-                radius: b.radius,
-                mass: b.mass,
-                fixed: Some(b.fixed.clone()),
-                pocket: b.pocket,
-                colour: None,
-                label: None,
-            }
+            BallSpec::taken_up(&b.traj, b.radius, b.mass, &b.fixed, b.pocket)
         })
         .collect()
 }

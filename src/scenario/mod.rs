@@ -8,7 +8,7 @@
 pub mod builtin;
 pub mod toml;
 
-use crate::geometry::Vec2;
+use crate::geometry::{Trajectory, Vec2};
 use crate::vtime::Key;
 use std::fmt;
 
@@ -49,6 +49,28 @@ pub struct BallSpec {
 }
 
 impl BallSpec {
+    /// A ball as a run holds it between events, for a run that takes that one up: on `traj`
+    /// since the event of key `fixed`, in `pocket` if it dropped into one; no looks (the run
+    /// copies them from its scenario).
+    pub fn taken_up(
+        traj: &Trajectory,
+        radius: f64,
+        mass: f64,
+        fixed: &Key,
+        pocket: Option<u32>,
+    ) -> BallSpec {
+        BallSpec {
+            position: traj.position,
+            velocity: traj.velocity,
+            radius,
+            mass,
+            fixed: Some(fixed.clone()),
+            pocket,
+            colour: None,
+            label: None,
+        }
+    }
+
     /// The key its trajectory was fixed at, in a run that starts at `start`.
     pub fn fixed_at(&self, start: f64) -> Key {
         self.fixed.clone().unwrap_or_else(|| Key::start(start))
