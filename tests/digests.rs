@@ -728,6 +728,43 @@ const TABLE: &[(&str, &str, &str, &str, &str)] = &[
         "1 0 0 0",
         "36 8 4 2 0 6 4 0 0 0 2 56",
     ),
+    // the implosion's balls run about 1,000 units per time unit: a time step of 0.001 would
+    // let them pass through one another, so it has no time-step row
+    (
+        "implosion",
+        "event-list",
+        "d7a23568a0e20ac6",
+        "4413 224 0 0",
+        "0 0 0 0 0 0 0 0 0 0 0 0",
+    ),
+    (
+        "implosion",
+        "objects",
+        "d7a23568a0e20ac6",
+        "4413 224 0 0",
+        "3728550 245622 235394 0 0 0 0 0 0 0 0 4209566",
+    ),
+    (
+        "implosion",
+        "sectored",
+        "d7a23568a0e20ac6",
+        "4413 224 0 0",
+        "3681718 228868 265864 9053 35502 24898 404 0 0 0 8828 4245903",
+    ),
+    (
+        "implosion",
+        "time-warp",
+        "d7a23568a0e20ac6",
+        "4413 224 0 0",
+        "3728550 245622 235394 0 0 0 0 0 0 0 0 4209566",
+    ),
+    (
+        "implosion",
+        "time-warp-sectored",
+        "d7a23568a0e20ac6",
+        "4413 224 0 0",
+        "3681718 228868 265864 9053 35502 24898 404 0 0 0 8828 4245903",
+    ),
 ];
 
 fn scenario(name: &str) -> Scenario {

@@ -274,3 +274,42 @@ fn the_break_is_deterministic_and_conserves_energy() {
         trace_a.len()
     );
 }
+
+#[test]
+fn a_cluster_that_forms_and_flies_apart_is_followed_by_the_grid() {
+    // 1,000 balls gather at t = 1 into a disc at area fraction 0.5 and then fly apart: the grid
+    // goes finer as they gather and coarser as they leave, and every event is checked on the way
+    let p = builtin::Params {
+        balls: Some(1000),
+        ..Default::default()
+    };
+    let s = builtin::build("implosion", &p).unwrap();
+    let mut rec = TraceRecorder::default();
+    let cfg = RunConfig {
+        engine: EngineKind::EventList,
+        until: s.until,
+        check: true,
+        span: Default::default(),
+        interrupt: None,
+        checkpoint_every: None,
+    };
+    let report = execute(&s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{e}"));
+    let stat = |name: &str| {
+        let found = report.outcome.engine_stats.iter().find(|(k, _)| *k == name);
+        found.expect("reported").1
+    };
+    assert!(
+        stat("grid_layouts") >= 2.0,
+        "{:?}",
+        report.outcome.engine_stats
+    );
+    // the cluster's events are most of the run, and a cluster at area fraction 0.5 in cells of
+    // at most 8 balls tests few pairs per prediction
+    let events = report.summary.events.total as f64;
+    assert!(events > 10_000.0, "{events} events");
+    assert!(
+        stat("predictions") < 200.0 * events,
+        "{:?}",
+        report.outcome.engine_stats
+    );
+}

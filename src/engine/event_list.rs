@@ -28,7 +28,7 @@ use super::{
     BallState, Event, EventCounts, EventKind, Fixed, Frame, InstantCap, Observer, Outcome,
     RunError, Span, Table, World,
 };
-use crate::geometry::Trajectory;
+use crate::geometry::{Trajectory, Vec2};
 use crate::physics::{self, Contact};
 use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
@@ -177,6 +177,9 @@ pub struct Stats {
     pub stale: u64,
     /// Balls leaving a grid cell.
     pub cell_crossings: u64,
+    /// Times the grid was laid out anew, finer where a cluster formed or coarser where one
+    /// spread out.
+    pub grid_layouts: u64,
     /// The deepest cascade of instantaneous collisions seen (1 = none).
     pub max_depth: usize,
 }
@@ -201,6 +204,8 @@ pub struct EventList {
     instant: InstantCap,
     /// Ends runs early, after the instant of the event that saw it raised.
     interrupt: Option<Interrupt>,
+    /// Cell crossings still to come before the grid's layout is looked at again.
+    look_in: u64,
 }
 
 /// Options of the event-list engine.
@@ -280,7 +285,9 @@ impl EventList {
             stats: Stats::default(),
             interrupt: None,
             instant: InstantCap::new(n),
+            look_in: 0,
         };
+        e.look_in = e.look_interval();
         // First predictions go into a provisional calendar; the real one's bucket width comes
         // from the mean time to each ball's first event (events then come about mean / n apart).
         for i in 0..n as u32 {
@@ -454,6 +461,43 @@ impl EventList {
         self.requeue(i);
     }
 
+    /// Lays the grid out anew if the balls' spread asks for finer cells (a cluster formed) or
+    /// coarser ones (it spread out), and then predicts every ball on the table anew in it. Its
+    /// cost, linear in the number of balls, is paid at most once per crowding or once per
+    /// [`EventList::look_interval`] crossings.
+    #[cold]
+    fn adapt_grid(&mut self) {
+        let on_table: Vec<u32> = (0..self.slots.len() as u32)
+            .filter(|&i| self.slots[i as usize].cell != NOT_ON_TABLE)
+            .collect();
+        let centres: Vec<Vec2> = on_table
+            .iter()
+            .map(|&i| self.slots[i as usize].traj.at(self.now))
+            .collect();
+        if let Some(grid) = self.grid.relaid(&self.table, &centres) {
+            self.grid = grid;
+            self.stats.grid_layouts += 1;
+            for (&i, &p) in on_table.iter().zip(&centres) {
+                self.slots[i as usize].cell = self.grid.insert_at(i, p);
+            }
+            for &i in &on_table {
+                self.predict(i);
+            }
+        }
+        self.look_in = self.look_interval();
+    }
+
+    /// Cell crossings between two looks at whether a coarser layout suits the balls: never if
+    /// the grid is at its coarsest, else as many as there are balls (at least 1024), so that the
+    /// looks cost a bounded share of the crossings.
+    fn look_interval(&self) -> u64 {
+        if self.grid.is_coarsest() {
+            u64::MAX
+        } else {
+            self.slots.len().max(1024) as u64
+        }
+    }
+
     /// Predicts when ball `i`'s centre leaves its cell, and which cell it enters.
     fn set_exit(&mut self, i: u32) {
         let b = &mut self.slots[i as usize];
@@ -485,7 +529,7 @@ impl EventList {
         queue.set(&mut balls, i);
     }
 
-    fn set_velocity(&mut self, i: u32, key: &Key, velocity: crate::geometry::Vec2) {
+    fn set_velocity(&mut self, i: u32, key: &Key, velocity: Vec2) {
         let b = &mut self.slots[i as usize];
         b.traj = Trajectory {
             position: b.traj.at(key.t),
@@ -539,6 +583,10 @@ impl EventList {
             if key.path[..] == [CELL_CROSSING] {
                 self.stats.cell_crossings += 1;
                 self.cross(i, self.own[i as usize].cross_cell);
+                self.look_in -= 1;
+                if self.look_in == 0 || self.grid.is_crowded() {
+                    self.adapt_grid();
+                }
                 continue;
             }
             let (kind, a, b) = match self.own[i as usize].phys.partner {
@@ -666,6 +714,7 @@ impl EventList {
                 ("predictions", self.stats.predictions as f64),
                 ("stale_events", self.stats.stale as f64),
                 ("cell_crossings", self.stats.cell_crossings as f64),
+                ("grid_layouts", self.stats.grid_layouts as f64),
                 ("max_cascade_depth", self.stats.max_depth as f64),
             ],
             messages: Vec::new(),

@@ -5,22 +5,27 @@
 //! cells reach out to infinity: a ball that leaves the table's box stays in its edge cell and the
 //! neighbourhood rule still holds.
 //!
-//! Cells are as narrow as that rule allows wherever the balls are, so that a dense cluster costs
-//! no more per event than the same balls spread out, and memory stays linear in the ball count
-//! `N` on any table. Two layouts share one set of cell ids:
+//! A dense cluster should cost no more per event than the same balls spread out, and memory
+//! should stay linear in the ball count `N` on any table. The grid may take one of several
+//! layouts, from cells a diameter wide to cells widened until the table holds
+//! about `4 N` of them (fewer crossings), and takes the coarsest in which no more than
+//! [`CROWDED`] balls share a cell (with at most [`FEW_BALLS`] balls, the coarsest of all: no
+//! cell can hold many). Every layout shares one set of cell ids, in one of two forms:
 //!
-//! * **Dense**, when the table holds at most about `4 N` such cells: an array of every cell in
-//!   row order, so the 3 × 3 block around a cell is three short runs of memory and its
-//!   neighbours are found by arithmetic on the id. On a larger table its cells are widened until
-//!   there are about `4 N` of them, which means fewer crossings, if there are few balls (at most
-//!   [`FEW_BALLS`]: no cell can hold many) or if no more than [`CROWDED`] start in any one cell
-//!   (a dilute gas; a cluster that forms later costs more pair tests but works).
-//! * **Hashed**, for a cluster on a large table: only the cells near a ball exist, under compact ids from a hash of
-//!   their coordinates; each keeps the ids of its existing neighbours. A cell comes into use when
-//!   a ball is put in it or its next crossing enters it (always a cell next to the ball's), and
-//!   once about `12 N` are in use a sweep recycles those with no ball in their 3 × 3 block.
-//!   Fixed objects are listed per square block of cells, about `4 N` blocks in all, and a cell
-//!   takes its block's list.
+//! * **Dense**, the coarsest layout: an array of every cell in row order, so the 3 × 3 block
+//!   around a cell is three short runs of memory and its neighbours are found by arithmetic on
+//!   the id.
+//! * **Hashed**, every finer one: only the cells near a ball exist, under compact ids from a
+//!   hash of their coordinates; each keeps the ids of its existing neighbours. A cell comes into
+//!   use when a ball is put in it or its next crossing enters it (always a cell next to the
+//!   ball's), and once about `12 N` are in use a sweep recycles those with no ball in their
+//!   3 × 3 block. Fixed objects are listed per square block of cells, about `4 N` blocks in all,
+//!   and a cell takes its block's list.
+//!
+//! Balls move, so the layout that suits them changes: a cluster forms in a dilute gas, or
+//! flies apart. A cell that overflows its slots marks the grid crowded, and the engine that owns
+//! it asks [`Grid::relaid`] for a finer layout; it also asks from time to time whether a
+//! coarser one suits the balls again, and then places every ball anew.
 //!
 //! Each cell stores its balls' indices inline in a fixed number of slots, so a block's balls are
 //! read from a few short runs of memory and the balls' own records can then be fetched in
@@ -47,7 +52,8 @@ const CELL_MARGIN: f64 = 1.0 + 1e-6;
 /// and wider cells mean fewer crossings.
 pub const FEW_BALLS: usize = 64;
 
-/// A grid widened to fit the table is used only if at most this many balls start in each cell.
+/// A layout is used only if at most this many balls share any one of its cells (bar the finest,
+/// which is used in any case).
 pub const CROWDED: usize = 8;
 
 /// The most slots a cell holds inline; further balls go to its spill list.
@@ -99,6 +105,75 @@ pub struct Grid {
     hashed: Option<Box<Hashed>>,
     /// The balls beyond a full cell's slots, by cell.
     spill: FxHashMap<u32, Vec<u32>>,
+    /// Set when a cell overflows its slots in a layout that has finer ones (with more than
+    /// [`FEW_BALLS`] balls).
+    crowded: bool,
+    /// Which of `layouts` this grid is.
+    level: usize,
+    /// The layouts the grid may take over its table.
+    layouts: Layouts,
+}
+
+/// The layouts a grid may take over one table, from the finest (cells at least a diameter wide,
+/// hashed if the table holds more than about `4 N` of them) to the coarsest (the dense layout).
+#[derive(Clone, Debug)]
+struct Layouts {
+    /// Cells along x and y of each layout: the finest first, and each next one with half as many
+    /// along each side, until the table holds at most about `4 N` cells.
+    dims: Vec<(u32, u32)>,
+    /// About `4 N`: the most cells of the dense layout, and of the hashed layout's blocks.
+    most: f64,
+    /// The smallest cell width.
+    w_min: f64,
+    /// The largest ball radius.
+    rmax: f64,
+    /// The number of balls the grid places.
+    n: usize,
+}
+
+impl Layouts {
+    /// The layouts for `n` balls of radius at most `rmax` on `table`, cells at least `min_cell`
+    /// wide.
+    fn new(table: &Table, n: usize, rmax: f64, min_cell: f64) -> Layouts {
+        let span = table.hi - table.lo;
+        let w_min = (2.0 * rmax * CELL_MARGIN).max(min_cell);
+        let most = (4 * n).max(16) as f64;
+        let (mut nx, mut ny) = (
+            (span.x / w_min).floor().clamp(1.0, MAX_SIDE),
+            (span.y / w_min).floor().clamp(1.0, MAX_SIDE),
+        );
+        let mut dims = vec![(nx as u32, ny as u32)];
+        while nx * ny > most {
+            nx = (nx / 2.0).floor().max(1.0);
+            ny = (ny / 2.0).floor().max(1.0);
+            dims.push((nx as u32, ny as u32));
+        }
+        Layouts {
+            dims,
+            most,
+            w_min,
+            rmax,
+            n,
+        }
+    }
+
+    /// The coarsest layout among `levels` in which no more than `limit` of `centres` share a
+    /// cell (with at most [`FEW_BALLS`] balls, the coarsest of all: no cell can hold many), or
+    /// `None` if there is none.
+    fn coarsest(
+        &self,
+        table: &Table,
+        centres: &[Vec2],
+        levels: std::ops::Range<usize>,
+        limit: usize,
+    ) -> Option<usize> {
+        if self.n <= FEW_BALLS {
+            return Some(self.dims.len() - 1).filter(|l| levels.contains(l));
+        }
+        levels
+            .rev()
+            .find(|&l| !crowded(table, centres, self.dims[l], limit))
+    }
 }
 
 /// The cells of the hashed layout: those in use, under compact ids.
@@ -125,29 +200,25 @@ struct Hashed {
 impl Grid {
     /// Builds a grid for `table` with balls of radius at most `rmax` whose centres start at
     /// `centres`, and the given minimum cell width (at least a diameter; larger means fewer
-    /// crossings, more pair tests). The layout is dense if the table holds at most about `4 n`
-    /// such cells; otherwise its cells are widened until there are about `4 n` of them, unless
-    /// more than a few balls would start in one of those ([`CROWDED`]; then the layout is hashed,
-    /// its cells unwidened).
+    /// crossings, more pair tests). Its layout is the coarsest of its layouts in which no more
+    /// than [`CROWDED`] balls start in any one cell.
     pub fn new(table: &Table, centres: &[Vec2], rmax: f64, min_cell: f64) -> Grid {
-        let n = centres.len();
+        let layouts = Layouts::new(table, centres.len(), rmax, min_cell);
+        let levels = layouts.dims.len();
+        let level = match levels {
+            1 => 0,
+            _ => layouts
+                .coarsest(table, centres, 0..levels, CROWDED)
+                .unwrap_or(0),
+        };
+        Grid::laid_out(table, layouts, level)
+    }
+
+    /// An empty grid in `layouts`' layout number `level`.
+    fn laid_out(table: &Table, layouts: Layouts, level: usize) -> Grid {
+        let (nx, ny) = layouts.dims[level];
+        let hashed = level + 1 < layouts.dims.len();
         let span = table.hi - table.lo;
-        let w_min = (2.0 * rmax * CELL_MARGIN).max(min_cell);
-        let most = (4 * n).max(16) as f64;
-        let fine = (
-            (span.x / w_min).floor().clamp(1.0, MAX_SIDE),
-            (span.y / w_min).floor().clamp(1.0, MAX_SIDE),
-        );
-        let (mut nx, mut ny) = fine;
-        while nx * ny > most {
-            nx = (nx / 2.0).floor().max(1.0);
-            ny = (ny / 2.0).floor().max(1.0);
-        }
-        let hashed = fine.0 * fine.1 > most
-            && n > FEW_BALLS
-            && crowded(table, centres, (nx as u32, ny as u32));
-        let (nx, ny) = if hashed { fine } else { (nx, ny) };
-        let (nx, ny) = (nx as u32, ny as u32);
         let cells = if hashed { 0 } else { (nx * ny) as usize };
         let mut g = Grid {
             lo: table.lo,
@@ -157,21 +228,24 @@ impl Grid {
             ny,
             cap: 4,
             slots: vec![NIL; 4 * cells],
-            cell_of: vec![NIL; n],
+            cell_of: vec![NIL; layouts.n],
             fixed_span: Vec::with_capacity(cells),
             fixed_items: Vec::new(),
             has_fixed: vec![0; cells.div_ceil(64)],
             general: hashed,
             hashed: None,
             spill: FxHashMap::default(),
+            crowded: false,
+            level,
+            layouts,
         };
         if g.width.is_nan() || g.width <= 0.0 || g.height.is_nan() || g.height <= 0.0 {
-            g.width = w_min;
-            g.height = w_min;
+            g.width = g.layouts.w_min;
+            g.height = g.layouts.w_min;
         }
-        let reach2 = (rmax * 1.01 + 1e-9 * (g.width + g.height)).powi(2);
+        let reach2 = (g.layouts.rmax * 1.01 + 1e-9 * (g.width + g.height)).powi(2);
         if hashed {
-            g.hashed = Some(Box::new(g.blocks(table, reach2, most)));
+            g.hashed = Some(Box::new(g.blocks(table, reach2, g.layouts.most)));
         } else {
             for c in 0..nx * ny {
                 let span = g.list_fixed(table, reach2, g.cell_rect((c % nx, c / nx)));
@@ -182,6 +256,41 @@ impl Grid {
             }
         }
         g
+    }
+
+    /// An empty grid laid out for balls whose centres are now at `centres` (those on the table),
+    /// or `None` if the present layout still suits them. A finer layout suits them once a cell
+    /// of this one has overflowed its slots (a cluster has formed): the coarsest finer one where
+    /// no cell holds more than [`CROWDED`]. A coarser layout suits them if no cell of it holds
+    /// more than [`CROWDED`] (a cluster has spread out): the coarsest such.
+    pub fn relaid(&mut self, table: &Table, centres: &[Vec2]) -> Option<Grid> {
+        let last = self.layouts.dims.len() - 1;
+        let level = if std::mem::take(&mut self.crowded) {
+            let coarsest = self
+                .layouts
+                .coarsest(table, centres, 0..self.level + 1, CROWDED);
+            coarsest.unwrap_or(0)
+        } else if self.level < last {
+            let coarser = self.level + 1..last + 1;
+            let coarsest = self.layouts.coarsest(table, centres, coarser, CROWDED);
+            coarsest.unwrap_or(self.level)
+        } else {
+            self.level
+        };
+        (level != self.level).then(|| Grid::laid_out(table, self.layouts.clone(), level))
+    }
+
+    /// Whether the layout is the coarsest the grid may take.
+    #[inline]
+    pub fn is_coarsest(&self) -> bool {
+        self.level + 1 == self.layouts.dims.len()
+    }
+
+    /// Whether a cell of a layout that has finer ones has overflowed its slots since the grid
+    /// was laid out: a cluster has formed.
+    #[inline]
+    pub fn is_crowded(&self) -> bool {
+        self.crowded
     }
 
     /// The hashed layout, with no cell in use yet and the fixed objects listed per square block
@@ -326,12 +435,13 @@ impl Grid {
     /// Puts ball `i` into the spill list of cell `c`, whose slots are full.
     #[cold]
     fn spill_into(&mut self, i: u32, c: u32) {
+        self.crowded |= self.level > 0 && self.layouts.n > FEW_BALLS;
         self.spill.entry(c).or_default().push(i);
         self.cell_of[i as usize] = c;
         self.general = true;
     }
 
-    /// Doubles every cell's slots (a cell overflowed: balls of very different sizes).
+    /// Doubles every cell's slots (a cell overflowed).
     fn grow(&mut self) {
         let cap = 2 * self.cap;
         let cells = self.slots.len() / self.cap;
@@ -749,12 +859,13 @@ impl Grid {
     }
 }
 
-/// Whether more than [`CROWDED`] of `centres` fall in one cell of an `nx` × `ny` grid over
-/// `table`.
-fn crowded(table: &Table, centres: &[Vec2], (nx, ny): (u32, u32)) -> bool {
+/// Whether more than `limit` of `centres` fall in one cell of an `nx` × `ny` grid over `table`.
+fn crowded(table: &Table, centres: &[Vec2], (nx, ny): (u32, u32), limit: usize) -> bool {
     let span = table.hi - table.lo;
     let (w, h) = (span.x / f64::from(nx), span.y / f64::from(ny));
-    let mut count = vec![0usize; (nx * ny) as usize];
+    let dense = u64::from(nx) * u64::from(ny) <= 4 * centres.len() as u64 + 16;
+    let mut count = vec![0usize; if dense { (nx * ny) as usize } else { 0 }];
+    let mut hashed = FxHashMap::<u64, usize>::default();
     centres.iter().any(|p| {
         let cx = ((p.x - table.lo.x) / w)
             .floor()
@@ -762,9 +873,15 @@ fn crowded(table: &Table, centres: &[Vec2], (nx, ny): (u32, u32)) -> bool {
         let cy = ((p.y - table.lo.y) / h)
             .floor()
             .clamp(0.0, f64::from(ny - 1)) as u32;
-        let k = &mut count[(cy * nx + cx) as usize];
+        let k = if dense {
+            &mut count[(cy * nx + cx) as usize]
+        } else {
+            hashed
+                .entry(u64::from(cy) << 32 | u64::from(cx))
+                .or_default()
+        };
         *k += 1;
-        *k > CROWDED
+        *k > limit
     })
 }
 
@@ -836,6 +953,72 @@ mod tests {
             assert!(entering.is_empty());
             assert!(near(&g, to).len() == odd.len() + 1);
         }
+    }
+
+    /// Places `centres` in a grid as an engine does, and returns the grid's cell for each.
+    fn place(g: &mut Grid, centres: &[Vec2]) -> Vec<u32> {
+        (0..centres.len() as u32)
+            .map(|i| g.insert_at(i, centres[i as usize]))
+            .collect()
+    }
+
+    #[test]
+    fn the_layout_follows_a_cluster_as_it_forms_and_spreads_out() {
+        // 400 balls on a 4000 x 4000 table: spread out on a 20 x 20 lattice 200 apart, the
+        // dense layout of about 1,600 cells suits them
+        let n = 400;
+        let t = table(n, 4000.0);
+        let spread: Vec<Vec2> = (0..n)
+            .map(|k| {
+                Vec2::new(
+                    100.0 + 200.0 * (k % 20) as f64,
+                    100.0 + 200.0 * (k / 20) as f64,
+                )
+            })
+            .collect();
+        let mut g = Grid::new(&t, &spread, 1.0, 2.0);
+        assert!(!g.is_hashed() && g.is_coarsest());
+        place(&mut g, &spread);
+        assert!(!g.is_crowded());
+        assert!(g.relaid(&t, &spread).is_none(), "nothing coarser exists");
+        // the balls gather into a 20 x 20 square 3 apart: a cell overflows, and the finer layout
+        // chosen holds at most CROWDED balls in a cell
+        let cluster: Vec<Vec2> = (0..n)
+            .map(|k| {
+                Vec2::new(
+                    2000.0 + 3.0 * (k % 20) as f64,
+                    2000.0 + 3.0 * (k / 20) as f64,
+                )
+            })
+            .collect();
+        for i in 0..n as u32 {
+            g.move_to(i, cluster[i as usize]);
+        }
+        assert!(g.is_crowded());
+        let mut fine = g.relaid(&t, &cluster).expect("a finer layout");
+        assert!(!g.is_crowded(), "asking clears the mark");
+        assert!(fine.is_hashed() && !fine.is_coarsest());
+        let cells = place(&mut fine, &cluster);
+        for &c in &cells {
+            assert!(cells.iter().filter(|&&d| d == c).count() <= CROWDED);
+        }
+        assert!(!fine.is_crowded());
+        // nothing coarser suits the cluster; once it has spread out again, the dense layout does
+        assert!(fine.relaid(&t, &cluster).is_none());
+        let coarse = fine.relaid(&t, &spread).expect("a coarser layout");
+        assert!(!coarse.is_hashed() && coarse.is_coarsest());
+        assert_eq!(coarse.dims(), g.dims());
+    }
+
+    #[test]
+    fn few_balls_keep_the_coarsest_layout() {
+        let n = FEW_BALLS;
+        let t = table(n, 4000.0);
+        let mut g = Grid::new(&t, &vec![Vec2::new(5.0, 5.0); n], 1.0, 2.0);
+        assert!(!g.is_hashed());
+        place(&mut g, &vec![Vec2::new(5.0, 5.0); n]);
+        assert!(!g.is_crowded());
+        assert!(g.relaid(&t, &vec![Vec2::new(5.0, 5.0); n]).is_none());
     }
 
     #[test]

@@ -7,6 +7,7 @@
 //! | `reversal` | the reversal test of thesis 4.6–4.7: a 4 × 4 array with random velocities |
 //! | `pool` | a racked break on a 2:1 table with six pockets |
 //! | `cradle` | Newton's cradle: one ball strikes a row of five touching balls |
+//! | `implosion` | a dilute gas whose balls all head for one small disc: a cluster forms and flies apart |
 //!
 //! Coordinates have y up. Cushions and pockets run clockwise around the table, so the table lies
 //! on the right going from `from` to `to` (the right-hand normal of each side points inward).
@@ -73,7 +74,15 @@ struct Builtin {
     build: fn(&Params) -> Result<Scenario, Invalid>,
 }
 
-const BUILTINS: [Builtin; 5] = [
+const IMPLOSION_BALLS: usize = 400;
+const IMPLOSION_RADIUS: f64 = 1.0;
+/// The area fraction of the disc the implosion's balls head for.
+const IMPLOSION_FRACTION: f64 = 0.5;
+/// The implosion's table side over `√N · r`: the balls start about 80 radii apart.
+const IMPLOSION_SIDE: f64 = 100.0;
+const IMPLOSION_UNTIL: f64 = 3.0;
+
+const BUILTINS: [Builtin; 6] = [
     Builtin {
         name: "plate1",
         describe: || {
@@ -122,6 +131,19 @@ const BUILTINS: [Builtin; 5] = [
                 .into()
         },
         build: cradle,
+    },
+    Builtin {
+        name: "implosion",
+        describe: || {
+            format!(
+                "a dilute gas heading for one disc: {BALLS} {IMPLOSION_BALLS} balls ({RADIUS} \
+                 {IMPLOSION_RADIUS}) spread over a square table {IMPLOSION_SIDE} sqrt(N) r wide, \
+                 each aimed at a random point of a central disc that would hold them all at area \
+                 fraction {AREA} {IMPLOSION_FRACTION}, reached at t = 1; the cluster then flies \
+                 apart ({SEED} {DEFAULT_SEED}); until {IMPLOSION_UNTIL}"
+            )
+        },
+        build: implosion,
     },
 ];
 
@@ -573,6 +595,65 @@ fn cradle(p: &Params) -> Result<Scenario, Invalid> {
     })
 }
 
+/// A dilute gas that gathers into one dense cluster and flies apart: a test of any grid laid out
+/// for where the balls start. The balls start on the first `n` sites of a `k × k` grid over the
+/// middle 80 % of the table (`k² ≥ n`), each moved at random within its site, and head for a
+/// point drawn uniformly in the disc at the table's centre that would hold them all at the area
+/// fraction given, which they reach at t = 1 unless they meet on the way.
+fn implosion(p: &Params) -> Result<Scenario, Invalid> {
+    allow(p, "implosion", &[BALLS, SEED, RADIUS, AREA])?;
+    let n = p.balls.unwrap_or(IMPLOSION_BALLS);
+    if n == 0 || n > MAX_BALLS {
+        return Err(bad(
+            BALLS,
+            format!("must be from 1 to {MAX_BALLS}, got {n}"),
+        ));
+    }
+    let r = radius_param(p, IMPLOSION_RADIUS)?;
+    let phi = p.area_fraction.unwrap_or(IMPLOSION_FRACTION);
+    if !(phi > 0.0 && phi < 1.0) {
+        return Err(bad(AREA, format!("must be between 0 and 1, got {phi}")));
+    }
+    let side = IMPLOSION_SIDE * (n as f64).sqrt() * r;
+    let k = ceil_sqrt(n);
+    let site = 0.8 * side / k as f64;
+    let disc = (n as f64 / phi).sqrt() * r;
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed.unwrap_or(DEFAULT_SEED));
+    let mut unit_disc = || loop {
+        let (x, y) = (2.0 * rng.gen::<f64>() - 1.0, 2.0 * rng.gen::<f64>() - 1.0);
+        if x * x + y * y <= 1.0 {
+            return Vec2::new(x, y);
+        }
+    };
+    let centre = Vec2::new(side / 2.0, side / 2.0);
+    let balls = (0..n)
+        .map(|s| {
+            let corner = site * Vec2::new((s % k) as f64, (s / k) as f64);
+            let jitter = 0.5 * site - r * (1.0 + GAP);
+            let position = Vec2::new(0.1 * side, 0.1 * side)
+                + corner
+                + Vec2::new(0.5 * site, 0.5 * site)
+                + jitter * unit_disc();
+            let aim = centre + disc * unit_disc();
+            ball(
+                position.x,
+                position.y,
+                aim.x - position.x,
+                aim.y - position.y,
+                r,
+            )
+        })
+        .collect();
+    Ok(Scenario {
+        name: "implosion".into(),
+        until: IMPLOSION_UNTIL,
+        balls,
+        cushions: box_cushions(side, side),
+        pockets: Vec::new(),
+        sectors: None,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -595,7 +676,10 @@ mod tests {
 
     #[test]
     fn every_builtin_builds_validates_and_is_named() {
-        assert_eq!(names(), ["plate1", "gas", "reversal", "pool", "cradle"]);
+        assert_eq!(
+            names(),
+            ["plate1", "gas", "reversal", "pool", "cradle", "implosion"]
+        );
         for (name, description) in list() {
             assert!(!description.is_empty() && !description.contains('\n'));
             let s = build(name, &Params::default()).unwrap();
@@ -926,6 +1010,42 @@ mod tests {
         }
         assert_eq!(s.balls[5].position, Vec2::new(300.0, 100.0));
         assert_eq!(s.balls[5].velocity, Vec2::new(100.0, 0.0));
+    }
+
+    #[test]
+    fn the_implosion_aims_every_ball_into_its_disc() {
+        for (balls, phi, seed) in [(None, None, None), (Some(1000), Some(0.3), Some(5))] {
+            let p = Params {
+                balls,
+                area_fraction: phi,
+                seed,
+                ..Default::default()
+            };
+            let s = build("implosion", &p).unwrap();
+            let n = balls.unwrap_or(IMPLOSION_BALLS);
+            assert_eq!(s.balls.len(), n);
+            let side = s.cushions[1].to.x;
+            let centre = Vec2::new(side / 2.0, side / 2.0);
+            let disc = (n as f64 / phi.unwrap_or(IMPLOSION_FRACTION)).sqrt();
+            for b in &s.balls {
+                assert!((b.position + b.velocity - centre).norm() <= disc, "{b:?}");
+                let inside = |x: f64| (0.1 * side..=0.9 * side).contains(&x);
+                assert!(inside(b.position.x) && inside(b.position.y), "{b:?}");
+            }
+        }
+        let speed = Params {
+            speed_max: Some(1.0),
+            ..Default::default()
+        };
+        let e = build("implosion", &speed).unwrap_err();
+        assert_eq!(e.field, "--speed-max");
+        for phi in [0.0, 1.0, f64::NAN] {
+            let p = Params {
+                area_fraction: Some(phi),
+                ..Default::default()
+            };
+            assert_eq!(build("implosion", &p).unwrap_err().field, "--area-fraction");
+        }
     }
 
     #[test]
