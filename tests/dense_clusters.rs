@@ -1,12 +1,13 @@
 //! Dense clusters on large tables: many ball centres per table-sized share of the grid (a rack on
-//! a big table, tiny balls packed close). Every engine runs them; the exact ones end exactly as
-//! the event list does, event for event, and the time-step engine runs them to the end.
+//! a big table, tiny balls packed close, a dilute gas that gathers into one disc). Every engine
+//! runs them; the exact ones end exactly as the event list does, event for event, and the
+//! time-step engine runs them to the end.
 
 use poolsim::geometry::Vec2;
 use poolsim::model::pool::NvDelay;
-use poolsim::output::TraceLine;
-use poolsim::run::{EngineKind, FixedNews, SectorChoice};
-use poolsim::scenario::{BallSpec, CushionSpec, Scenario};
+use poolsim::output::{TraceLine, TraceRecorder};
+use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
+use poolsim::scenario::{builtin, BallSpec, CushionSpec, Scenario};
 use rand::{Rng, SeedableRng};
 
 mod common;
@@ -192,4 +193,43 @@ fn balls_of_very_different_sizes_crowd_a_cell_on_any_table() {
         assert_eq!(run(&s, objects, false).1, digest, "on a {side} table");
         run(&s, EngineKind::TimeStep { dt: 0.001 }, false);
     }
+}
+
+#[test]
+fn a_cluster_that_forms_and_flies_apart_is_followed_by_the_grid() {
+    // 1,000 balls gather at t = 1 into a disc at area fraction 0.5 and then fly apart: the grid
+    // goes finer as they gather and coarser as they leave, and every event is checked on the way
+    let p = builtin::Params {
+        balls: Some(1000),
+        ..Default::default()
+    };
+    let s = builtin::build("implosion", &p).unwrap();
+    let mut rec = TraceRecorder::default();
+    let cfg = RunConfig {
+        engine: EngineKind::EventList,
+        until: s.until,
+        check: true,
+        span: Default::default(),
+        interrupt: None,
+        checkpoint_every: None,
+    };
+    let report = execute(&s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{e}"));
+    let stat = |name: &str| {
+        let found = report.outcome.engine_stats.iter().find(|(k, _)| *k == name);
+        found.expect("reported").1
+    };
+    assert!(
+        stat("grid_layouts") >= 2.0,
+        "{:?}",
+        report.outcome.engine_stats
+    );
+    // the cluster's events are most of the run, and a cluster at area fraction 0.5 in cells of
+    // at most 8 balls tests few pairs per prediction
+    let events = report.summary.events.total as f64;
+    assert!(events > 10_000.0, "{events} events");
+    assert!(
+        stat("predictions") < 200.0 * events,
+        "{:?}",
+        report.outcome.engine_stats
+    );
 }

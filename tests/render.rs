@@ -183,6 +183,80 @@ fn plate7_lists_the_balls_in_each_sector_and_the_sectors_of_each_ball() {
     );
 }
 
+/// The pixel boxes of the `<text class="CLASS">` blocks of a frame, by the widths of DejaVu Sans
+/// (the frame's font): left, top, right, bottom.
+fn text_boxes(svg: &str, class: &str) -> Vec<[f64; 4]> {
+    let open = format!("<text class=\"{class}\"");
+    svg.match_indices(&open)
+        .map(|(i, _)| {
+            let body = &svg[i..i + svg[i..].find("</text>").expect("a text ends")];
+            let tag = &body[..body.find('>').expect("a start tag ends") + 1];
+            let font = num(tag, "font-size");
+            let spans = elements(body, "tspan", "y=");
+            let lines: Vec<&str> = body
+                .split("<tspan")
+                .skip(1)
+                .map(|t| {
+                    let s = &t[t.find('>').expect("a tspan opens") + 1..];
+                    &s[..s.find("</tspan>").expect("a tspan ends")]
+                })
+                .collect();
+            let w = lines
+                .iter()
+                .map(|l| poolsim::render::text_box::width(l, font))
+                .fold(0.0, f64::max);
+            let x0 = match attr(tag, "text-anchor") {
+                "start" => num(tag, "x"),
+                "end" => num(tag, "x") - w,
+                _ => num(tag, "x") - w / 2.0,
+            };
+            let (top, bottom) = (num(spans[0], "y"), num(spans[spans.len() - 1], "y"));
+            [x0, top - 0.93 * font, x0 + w, bottom + 0.24 * font]
+        })
+        .collect()
+}
+
+#[test]
+fn sector_lists_in_frames_step_off_the_balls_and_their_names() {
+    // the 36-ball gas on 2 x 2 sectors: at t = 1 balls sit on the centroids of sectors 1 and 4,
+    // and their lists move to free room within the sector; no frame loses a sector's name
+    let mut cfg = config(sectored(SectorChoice::Grid(2, 2)), 4.0, 1.0);
+    cfg.sectors = Some(SectorChoice::Grid(2, 2));
+    let rec = record(&scenario("gas"), &cfg).expect("the gas records");
+    let meets =
+        |a: &[f64; 4], b: &[f64; 4]| a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+    for shot in &rec.shots {
+        let svg = svg::frame(&rec.scene, shot, &Style::default());
+        let mut taken = text_boxes(&svg, "label ball-label");
+        assert_eq!(taken.len(), 36);
+        for c in elements(&svg, "circle", "class=\"ball\"") {
+            let (x, y, r) = (num(c, "cx"), num(c, "cy"), num(c, "r"));
+            taken.push([x - r, y - r, x + r, y + r]);
+        }
+        let sectors = text_boxes(&svg, "label sector-label");
+        assert_eq!(
+            sectors.len(),
+            4,
+            "t = {}: a sector lost its label",
+            shot.frame.t
+        );
+        for s in sectors {
+            assert!(
+                !taken.iter().any(|t| meets(t, &s)),
+                "t = {}: {s:?}",
+                shot.frame.t
+            );
+            taken.push(s);
+        }
+        // at t = 0 the balls stand on a lattice with no room for a list between them
+        for k in 1..=4 {
+            let lines = text_block(&svg, "label sector-label", &format!("Sector-{k}"));
+            let room = shot.frame.t == 1.0;
+            assert!(!room || lines.len() > 1, "t = 1: Sector-{k} lists no ball");
+        }
+    }
+}
+
 /// The SVG without the counts (the objects engines add a messages line).
 fn picture(rec: &Recording, k: usize) -> String {
     let svg = svg::frame(&rec.scene, &rec.shots[k], &Style::default());

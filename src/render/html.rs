@@ -12,7 +12,7 @@
 //! `?t=T` opens the page paused at `T`, and `&dump=1` also writes `state()` as JSON into
 //! `<pre id="poolsim-state">` (for `chromium --headless --dump-dom`).
 
-use super::svg::{self, colour, pocket_anchor, sector_anchor, Anchor, Style, View};
+use super::svg::{self, colour, pocket_anchor, sector_anchors, Anchor, Style, View};
 use super::{format_time, History, Recording, Scene};
 use crate::engine::{BallState, EventKind, Fixed};
 use crate::summary::MessageCounts;
@@ -55,7 +55,7 @@ fn ball_json(b: &BallState) -> Value {
     json!([b.traj.position.x, b.traj.position.y, v.x, v.y, b.pocket])
 }
 
-/// Every sector's name, polygon and label anchor.
+/// Every sector's name, polygon and the anchors its label may take, best first.
 fn sectors_json(scene: &Scene, view: &View) -> Vec<Value> {
     let Some(layout) = &scene.sectors else {
         return Vec::new();
@@ -69,7 +69,7 @@ fn sectors_json(scene: &Scene, view: &View) -> Vec<Value> {
             json!({
                 "name": Scene::sector_name(k),
                 "points": pts,
-                "anchor": sector_anchor(scene, view, k).map(|a| anchor_json(&a)),
+                "anchors": sector_anchors(scene, view, k).iter().map(anchor_json).collect::<Vec<_>>(),
             })
         })
         .collect()

@@ -28,6 +28,7 @@ pub mod raster;
 #[path = "no_raster.rs"]
 pub mod raster;
 pub mod svg;
+pub mod text_box;
 
 use crate::engine::objects::Objects;
 use crate::engine::{

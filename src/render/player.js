@@ -226,7 +226,7 @@
         D.sectors.forEach((sec, k) => {
           const names = [];
           balls.forEach((b, i) => { if (inSectors[i].indexOf(k) >= 0) names.push(D.balls[i].name); });
-          s += textBlock(sec.anchor, listLines(sec.name, names), 'label sector-label', C.colours.sector, C.font);
+          s += textBlock(sec.anchors[0], listLines(sec.name, names), 'label sector-label', C.colours.sector, C.font);
         });
       }
     }
@@ -245,30 +245,40 @@
     showCounts(ev, msg);
   }
 
-  // A sector's label that would cover a ball's name shows the sector's name alone, or, if even
-  // that would, nothing: its name and list then show on hover over the sector (the page
-  // measures its text; SVG and PNG frames keep the plates' lists).
+  // A sector's label stands at the first of its anchors where it covers no named ball nor
+  // another sector's label; else its name alone at the first such anchor; else nowhere. What it
+  // does not show, it shows on hover over the sector's outline. SVG and PNG frames follow the
+  // same rule with text widths from the font's metrics.
   function unclutter() {
-    const boxes = (sel) => Array.from(dyn.querySelectorAll(sel)).map((e) => e.getBBox());
-    const taken = boxes('text.ball-label');
+    const taken = Array.from(dyn.querySelectorAll('text.ball-label')).map((e) => e.getBBox());
+    if (taken.length > 0) dyn.querySelectorAll('circle.ball').forEach((e) => taken.push(e.getBBox()));
     const meets = (a, b) => a.x < b.x + b.width && b.x < a.x + a.width && a.y < b.y + b.height && b.y < a.y + a.height;
     const free = (box) => !taken.some((b) => meets(box, b));
     const outlines = svg.querySelectorAll('.sector');
     Array.from(dyn.querySelectorAll('text.sector-label')).forEach((e, k) => {
       const stale = outlines[k] && outlines[k].querySelector('title');
       if (stale) stale.remove();
-      if (free(e.getBBox())) { taken.push(e.getBBox()); return; }
       const spans = Array.from(e.querySelectorAll('tspan'));
       const text = spans.map((t) => t.textContent).join('\n');
-      spans.slice(1).forEach((t) => t.remove());
-      if (free(e.getBBox())) taken.push(e.getBBox()); else e.remove();
-      const outline = outlines[k];
-      if (outline) {
-        let title = outline.querySelector('title');
-        if (!title) { title = document.createElementNS(svg.namespaceURI, 'title'); outline.appendChild(title); }
+      const fits = () => D.sectors[k].anchors.some((a) => { moveBlock(e, a, C.font); return free(e.getBBox()); });
+      const whole = fits();
+      if (!whole) spans.slice(1).forEach((t) => t.remove());
+      if (whole || fits()) taken.push(e.getBBox()); else e.remove();
+      if (!whole && outlines[k]) {
+        let title = outlines[k].querySelector('title');
+        if (!title) { title = document.createElementNS(svg.namespaceURI, 'title'); outlines[k].appendChild(title); }
         title.textContent = text;
       }
     });
+  }
+  // Moves a text block written by textBlock to anchor a.
+  function moveBlock(e, a, font) {
+    const spans = Array.from(e.querySelectorAll('tspan'));
+    const line = C.line * font / C.font;
+    const y0 = firstBaseline(a, spans.length, line, font);
+    e.setAttribute('x', n(a.x));
+    e.setAttribute('y', n(y0));
+    spans.forEach((t, i) => { t.setAttribute('x', n(a.x)); t.setAttribute('y', n(y0 + i * line)); });
   }
 
   // ---- the side panel -----------------------------------------------------------------------

@@ -11,6 +11,7 @@
 //! `(left + (x - lo_x)·scale, top + (hi_y - y)·scale)`. Balls and vectors carry `data-ball`
 //! with the ball's name.
 
+use super::text_box::{self, Rect};
 use super::{centroid, format_time, sectors_of, Scene, Shot};
 use crate::engine::{BallState, EventKind, Fixed};
 use crate::geometry::Vec2;
@@ -258,16 +259,42 @@ pub fn pocket_anchor(scene: &Scene, view: &View, k: usize) -> Anchor {
     outside_anchor(view, from, to, 12.0)
 }
 
-/// The anchor of sector `k`'s label: its centroid.
-pub fn sector_anchor(scene: &Scene, view: &View, k: usize) -> Option<Anchor> {
-    let poly = &scene.sectors.as_ref()?.polys[k];
-    let (x, y) = view.px(centroid(&poly.points));
-    Some(Anchor {
-        x,
-        y,
-        h: "middle",
-        v: "center",
-    })
+/// Where sector `k`'s label may stand, best first: its centroid, then points inside the sector
+/// on rings around the centroid, nearest first, so that a label can step off the names of the
+/// balls it would cover.
+pub fn sector_anchors(scene: &Scene, view: &View, k: usize) -> Vec<Anchor> {
+    let Some(layout) = &scene.sectors else {
+        return Vec::new();
+    };
+    let poly = &layout.polys[k];
+    let c = centroid(&poly.points);
+    let (lo, hi) = poly.bounds();
+    let step = (hi - lo).x.min((hi - lo).y) / 10.0;
+    let d = std::f64::consts::FRAC_1_SQRT_2;
+    let directions = [
+        (0.0, 1.0),
+        (0.0, -1.0),
+        (1.0, 0.0),
+        (-1.0, 0.0),
+        (d, d),
+        (-d, d),
+        (d, -d),
+        (-d, -d),
+    ];
+    let rings =
+        (1..=4).flat_map(|j| directions.map(|(x, y)| c + j as f64 * step * Vec2::new(x, y)));
+    std::iter::once(c)
+        .chain(rings.filter(|&p| poly.contains(p)))
+        .map(|p| {
+            let (x, y) = view.px(p);
+            Anchor {
+                x,
+                y,
+                h: "middle",
+                v: "center",
+            }
+        })
+        .collect()
 }
 
 /// A list of names under a label, at most [`LIST_MAX`] lines with `… N more` at the end.
@@ -521,11 +548,12 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
         velocity_arrows(&mut out, scene, view, balls, style.arrow_time);
     }
     if style.labels {
+        let mut taken = Vec::new();
         if names_balls(scene, view, balls) {
-            ball_labels(&mut out, scene, view, balls, &in_sectors);
+            taken = ball_labels(&mut out, scene, view, balls, &in_sectors);
         }
         if sectored {
-            sector_labels(&mut out, scene, view, balls, &in_sectors);
+            sector_labels(&mut out, scene, view, balls, &in_sectors, taken);
         }
     }
     // Pocket labels and their lists are part of the state: always shown.
@@ -607,14 +635,16 @@ fn velocity_arrows(
     }
 }
 
-/// Each ball's name, and the sectors it is in, on the ball.
+/// Each ball's name, and the sectors it is in, on the ball. The boxes the names and the balls
+/// take.
 fn ball_labels(
     out: &mut String,
     scene: &Scene,
     view: &View,
     balls: &[BallState],
     in_sectors: &[Vec<u32>],
-) {
+) -> Vec<Rect> {
+    let mut taken = Vec::new();
     for (i, b) in balls.iter().enumerate() {
         if b.pocket.is_some() {
             continue;
@@ -636,24 +666,32 @@ fn ball_labels(
             h: "middle",
             v: "center",
         };
-        text_block(
-            out,
-            &a,
-            &lines,
-            "label ball-label",
-            colour::TEXT,
-            ball_font(b.radius * view.scale),
-        );
+        let font = ball_font(b.radius * view.scale);
+        text_block(out, &a, &lines, "label ball-label", colour::TEXT, font);
+        taken.push(text_box::block(&a, &lines, font));
+        let r = b.radius * view.scale;
+        taken.push(Rect {
+            x0: x - r,
+            y0: y - r,
+            x1: x + r,
+            y1: y + r,
+        });
     }
+    taken
 }
 
-/// Each sector's name and the balls in it.
+/// Each sector's name and the balls in it, at the first of its anchors ([`sector_anchors`])
+/// where they cover no named ball (`taken`) nor another sector's label; else its name alone at
+/// the first such anchor; else nothing (each ball's label names its sectors, so nothing is
+/// lost). Text widths are DejaVu Sans'; the page follows the same rule with the sizes its browser
+/// measures.
 fn sector_labels(
     out: &mut String,
     scene: &Scene,
     view: &View,
     balls: &[BallState],
     in_sectors: &[Vec<u32>],
+    mut taken: Vec<Rect>,
 ) {
     let Some(layout) = &scene.sectors else {
         return;
@@ -663,9 +701,17 @@ fn sector_labels(
             .filter(|&i| in_sectors[i].contains(&(k as u32)))
             .map(|i| scene.table.name(i as u32))
             .collect();
-        if let Some(a) = sector_anchor(scene, view, k) {
-            let lines = list_lines(Scene::sector_name(k), names);
-            text_block(out, &a, &lines, "label sector-label", colour::SECTOR, FONT);
+        let lines = list_lines(Scene::sector_name(k), names);
+        let anchors = sector_anchors(scene, view, k);
+        let fits = [&lines[..], &lines[..1]].into_iter().find_map(|lines| {
+            anchors.iter().find_map(|a| {
+                let rect = text_box::block(a, lines, FONT);
+                (!taken.iter().any(|t| t.meets(&rect))).then_some((a, lines, rect))
+            })
+        });
+        if let Some((a, lines, rect)) = fits {
+            text_block(out, a, lines, "label sector-label", colour::SECTOR, FONT);
+            taken.push(rect);
         }
     }
 }
