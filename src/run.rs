@@ -462,6 +462,19 @@ pub struct ReversalReport {
     pub still_pocketed: usize,
     /// Wall-clock seconds.
     pub wall_seconds: f64,
+    /// Every ball: where it was at `-quit` and where it is at `quit`.
+    pub balls: Vec<ReversedBall>,
+}
+
+/// Where one ball of a reversal run started and ended.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ReversedBall {
+    /// Its name.
+    pub name: String,
+    /// Its position at `-quit` (`null` if it started in a pocket).
+    pub start: Option<[f64; 2]>,
+    /// Its position at `quit` (`null` if it ended in a pocket).
+    pub end: Option<[f64; 2]>,
 }
 
 /// Runs `scenario` from `-quit` to `quit` with every ball reversed at 0, and measures how far the
@@ -501,6 +514,19 @@ pub fn reverse(
     let mut forward = Forward(0);
     let report = execute(scenario, &cfg, &mut forward)?;
     let initial = BallState::initial(scenario, -quit);
+    let table = crate::engine::Table::new(scenario);
+    let place = |b: &BallState, t: f64| {
+        let p = b.traj.at(t);
+        b.pocket.is_none().then_some([p.x, p.y])
+    };
+    let balls = (report.outcome.balls.iter().zip(&initial))
+        .enumerate()
+        .map(|(i, (b, a))| ReversedBall {
+            name: table.name(i as u32),
+            start: place(a, -quit),
+            end: place(b, quit),
+        })
+        .collect();
     let mut pos = 0.0f64;
     let mut vel = 0.0f64;
     let mut still = 0;
@@ -522,5 +548,6 @@ pub fn reverse(
         max_velocity_error: vel,
         still_pocketed: still,
         wall_seconds: report.wall_seconds,
+        balls,
     })
 }

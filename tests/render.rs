@@ -713,3 +713,187 @@ fn pool_balls_are_drawn_in_their_colours_with_their_numbers() {
     assert!(!svg.contains(">Ball-1<"), "the cue ball carries no text");
     assert_eq!(elements(&svg, "circle", "class=\"ball-disc\"").len(), 15);
 }
+
+/// The reversal experiment recorded from -3 through the reversal at 0 to 3 on `engine`.
+fn reversal(engine: EngineKind, frame_time: f64) -> Recording {
+    let cfg = RenderConfig {
+        start: -3.0,
+        reverse_at: Some(0.0),
+        ..config(engine, 3.0, frame_time)
+    };
+    record(&scenario("reversal"), &cfg).expect("the reversal records")
+}
+
+#[test]
+fn a_reversal_is_recorded_from_its_start_back_to_it() {
+    for engine in [
+        EngineKind::EventList,
+        OBJECTS,
+        sectored(SectorChoice::Grid(2, 2)),
+    ] {
+        let rec = reversal(engine, 0.2);
+        let times: Vec<f64> = rec.shots.iter().map(|s| s.frame.t).collect();
+        assert_eq!((times[0], times[30], times.len()), (-3.0, 3.0, 31));
+        for (k, s) in rec.shots.iter().enumerate() {
+            // every frame's mirror is drawn: -t for t, and the distance is measured after 0
+            assert_eq!(times[30 - k], -s.frame.t);
+            assert_eq!(s.mirror_distance.is_some(), s.frame.t >= 0.0);
+        }
+        let back = rec.shots[30].mirror_distance.unwrap();
+        assert!(back > 0.0 && back < 1e-9, "{}: {back}", rec.engine);
+        // the history holds the reversal: it gives every frame's balls, before and after it
+        let h = rec.history.as_ref().expect("a history");
+        for s in &rec.shots {
+            for (a, b) in h.frame_at(s.frame.t).balls.iter().zip(&s.frame.balls) {
+                let d = (a.traj.position - b.traj.position).norm();
+                assert!(d < 1e-9, "{} at {}: {d}", rec.engine, s.frame.t);
+                assert!((a.traj.velocity - b.traj.velocity).norm() < 1e-9);
+            }
+        }
+        let turn = rec
+            .scene
+            .turn
+            .as_ref()
+            .expect("the scene knows the reversal");
+        assert_eq!((turn.at, turn.end), (0.0, 3.0));
+        let first = svg::frame(&rec.scene, &rec.shots[0], &Style::default());
+        let last = svg::frame(&rec.scene, &rec.shots[30], &Style::default());
+        assert!(first.contains(">POOL SIMULATION AT -3.0<"));
+        assert!(first.contains(">every ball turns around at 0.0<"));
+        assert!(last.contains(">POOL SIMULATION AT 3.0<"));
+        assert!(last.contains("where it was at -3.0 is "));
+        assert_eq!(elements(&first, "circle", "class=\"start\"").len(), 0);
+        assert_eq!(elements(&last, "circle", "class=\"start\"").len(), 16);
+    }
+}
+
+/// Each ball's centre in a frame's SVG, in table coordinates, by name.
+fn centres(svg: &str) -> Vec<(String, (f64, f64))> {
+    elements(svg, "circle", "class=\"ball\"")
+        .into_iter()
+        .map(|c| {
+            let at = to_table(svg, num(c, "cx"), num(c, "cy"));
+            (attr(c, "data-ball").to_string(), at)
+        })
+        .collect()
+}
+
+#[test]
+fn reverse_draws_plates_5_and_6_and_a_page() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let d = dir.path();
+    let args = ["reverse", "reversal", "--quit", "3", "--json", "--out"];
+    let out = poolsim(&[&args[..], &["plates"]].concat(), d, &[]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("only the report on stdout");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("wrote plates: 31 frames every 0.2"),
+        "{err}"
+    );
+    let balls = report["balls"]
+        .as_array()
+        .expect("each ball's start and end");
+    assert_eq!(balls.len(), 16);
+    let read =
+        |k: usize| std::fs::read_to_string(d.join(format!("plates/frame-{k:04}.svg"))).unwrap();
+    // plate 5 is the first frame (t = -3) and plate 6 the last (t = 3), at the report's places
+    for (k, end) in [(0, "start"), (30, "end")] {
+        let drawn = centres(&read(k));
+        assert_eq!(drawn.len(), 16);
+        for ((name, (x, y)), b) in drawn.iter().zip(balls) {
+            assert_eq!(b["name"], name.as_str());
+            let p = &b[end];
+            let (px, py) = (p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
+            // frames place centres to a hundredth of a pixel
+            assert!(
+                (x - px).abs() < 0.01 && (y - py).abs() < 0.01,
+                "{name} {end}"
+            );
+        }
+        assert!(d.join(format!("plates/frame-{k:04}.png")).is_file());
+    }
+    for (bad, says) in [
+        (
+            vec!["--frame-time", "0.35"],
+            "--frame-time: 0.35 does not divide --quit 3",
+        ),
+        (
+            vec!["--frame-time", "0.2"],
+            "--frame-time: only --out draws frames",
+        ),
+        (
+            vec!["--engine", "time-step", "--dt", "0.01", "--out", "x"],
+            "--out: reverse draws",
+        ),
+    ] {
+        let mut a = vec!["reverse", "reversal", "--quit", "3"];
+        a.extend(&bad);
+        if !bad.contains(&"--out") && bad[1] == "0.35" {
+            a.extend(["--out", "y"]);
+        }
+        let out = poolsim(&a, d, &[]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{a:?}: {err}");
+        assert!(err.starts_with(&format!("poolsim: {says}")), "{err}");
+    }
+
+    let out = poolsim(
+        &["reverse", "reversal", "--quit", "3", "--out", "r.html"],
+        d,
+        &[],
+    );
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let Some(browser) = chromium() else {
+        assert!(
+            std::env::var_os("POOLSIM_REQUIRE_BROWSER").is_none(),
+            "POOLSIM_REQUIRE_BROWSER is set but no headless Chromium was found"
+        );
+        eprintln!("skipped the page: no headless browser");
+        return;
+    };
+    for (t, end) in [("-3", "start"), ("3", "end"), ("-1", "")] {
+        let (state, console) = browse(browser, &d.join("r.html"), t);
+        assert!(console.is_empty(), "console at t = {t}: {console:?}");
+        if end.is_empty() {
+            assert_eq!(state["mirror_distance"], serde_json::Value::Null);
+            continue;
+        }
+        for (got, b) in state["balls"].as_array().unwrap().iter().zip(balls) {
+            let p = &b[end];
+            for (axis, k) in [("x", 0), ("y", 1)] {
+                let (g, w) = (got[axis].as_f64().unwrap(), p[k].as_f64().unwrap());
+                assert!(
+                    (g - w).abs() <= 1e-9 * w.abs().max(1.0),
+                    "{} at {t}",
+                    b["name"]
+                );
+            }
+        }
+        if t == "3" {
+            let far = state["mirror_distance"]
+                .as_f64()
+                .expect("measured after the reversal");
+            assert!(far < 1e-9, "{far}");
+        }
+        // the layout: no two labels overlap, every arrow ends on the table
+        let layout = &state["layout"];
+        let boxes: Vec<Vec<f64>> = serde_json::from_value(layout["labels"].clone()).unwrap();
+        for (i, a) in boxes.iter().enumerate() {
+            for b in &boxes[i + 1..] {
+                let meet = a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+                assert!(!meet, "labels overlap at t = {t}: {a:?} {b:?}");
+            }
+        }
+        let table: Vec<f64> = serde_json::from_value(layout["table"].clone()).unwrap();
+        let arrows: Vec<Vec<f64>> = serde_json::from_value(layout["arrows"].clone()).unwrap();
+        for a in arrows {
+            let inside = a[2] >= table[0] - 1.0 && a[2] <= table[2] + 1.0;
+            assert!(
+                inside && a[3] >= table[1] - 1.0 && a[3] <= table[3] + 1.0,
+                "{a:?}"
+            );
+        }
+    }
+}

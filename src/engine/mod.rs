@@ -247,14 +247,29 @@ pub struct Span {
     /// a ball in a pocket then comes back out at the mirror image of the time it dropped in.
     pub reverse_at: Option<f64>,
     /// Time between frames of the display: frames are drawn at `start`, `start + F`, … (none
-    /// when `None`).
+    /// when `None`); with a reversal at `r`, on the grid `r + j F` through it instead.
     pub frame_time: Option<f64>,
 }
 
 impl Span {
-    /// The time of frame `k`.
+    /// The time of frame `k`. With a reversal at `r`, frames stand at `r + j F` for every whole
+    /// `j` from the first at or after `start`, so that each frame at `r + t` has its mirror at
+    /// `r - t`; when `start` is a whole number `m` of frame times before `r` (to 1e-9), the
+    /// frames at `j = ±m` are `start` and its mirror `2 r - start` exactly.
     pub fn frame(&self, k: u64) -> Option<f64> {
-        self.frame_time.map(|f| self.start + k as f64 * f)
+        let f = self.frame_time?;
+        let Some(r) = self.reverse_at else {
+            return Some(self.start + k as f64 * f);
+        };
+        let q = r - self.start;
+        let m = (q / f).round();
+        let whole = (q / f - m).abs() <= 1e-9 * m.abs().max(1.0);
+        let j = if whole { -m } else { (-q / f).ceil() } + k as f64;
+        Some(if whole && j.abs() == m {
+            r + j.signum() * q
+        } else {
+            r + j * f
+        })
     }
 }
 

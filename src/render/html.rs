@@ -88,6 +88,7 @@ fn frames_json(rec: &Recording) -> Vec<Value> {
                 "t": s.frame.t,
                 "events": s.events.by_kind,
                 "messages": s.messages.as_deref().map(MessageCounts::from_named),
+                "mirror_distance": s.mirror_distance,
             });
             if positions {
                 f["balls"] = s.frame.balls.iter().map(ball_json).collect();
@@ -165,7 +166,13 @@ pub fn data(rec: &Recording) -> Value {
     json!({
         "scenario": scene.name,
         "engine": rec.engine,
+        "start": rec.start,
         "until": rec.until,
+        "turn": scene.turn.as_ref().map(|t| json!({
+            "at": t.at,
+            "end": t.end,
+            "starts": t.starts.iter().map(|p| p.map(|p| [p.x, p.y])).collect::<Vec<_>>(),
+        })),
         "frame_time": rec.frame_time,
         "view": {
             "scale": view.scale, "lo_x": view.lo_x, "hi_y": view.hi_y,
@@ -211,8 +218,9 @@ pub fn page(rec: &Recording) -> String {
     let mut out = String::with_capacity(64 * 1024);
     out.push_str("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n");
     out.push_str(&format!(
-        "<title>poolsim: {name}, {} engine, 0 to {}</title>\n<style>{CSS}</style>\n</head>\n<body>\n",
+        "<title>poolsim: {name}, {} engine, {} to {}</title>\n<style>{CSS}</style>\n</head>\n<body>\n",
         rec.engine,
+        format_time(rec.start),
         format_time(rec.until)
     ));
     out.push_str(&format!(
@@ -228,6 +236,7 @@ pub fn page(rec: &Recording) -> String {
         "<button id=\"fwd\" type=\"button\" title=\"next frame\">&#9654;</button>",
         "<input id=\"time\" type=\"range\" min=\"0\" value=\"0\" aria-label=\"time\">",
         "<span>t = <span id=\"clock\">0.0</span></span>",
+        "<span id=\"mirror\" title=\"after a reversal: the largest distance between a ball now and where it was at the mirror time\"></span>",
         "<label>speed <select id=\"speed\">",
         "<option value=\"0.1\">0.1&#215;</option><option value=\"0.25\">0.25&#215;</option>",
         "<option value=\"0.5\">0.5&#215;</option><option value=\"1\" selected>1&#215;</option>",

@@ -57,7 +57,12 @@ pub const MAX_HISTORY: usize = 250_000;
 pub struct RenderConfig {
     /// The engine that makes the frames.
     pub engine: EngineKind,
-    /// End time; frames are drawn at `0, F, 2F, …` up to it.
+    /// The time of the scenario's positions, where the run and its first frame start.
+    pub start: f64,
+    /// When every ball turns around (thesis 4.6), if ever; frames then stand on a grid through
+    /// it ([`Span::frame`]).
+    pub reverse_at: Option<f64>,
+    /// End time; frames are drawn at `start, start + F, …` up to it.
     pub until: f64,
     /// Time between frames, `F` (positive).
     pub frame_time: f64,
@@ -71,11 +76,13 @@ pub struct RenderConfig {
 }
 
 impl RenderConfig {
-    /// Frames every `frame_time` up to `until` from `engine`; no checks, no sectors drawn, the
-    /// default history cap.
+    /// Frames every `frame_time` from 0 up to `until` from `engine`; no reversal, no checks, no
+    /// sectors drawn, the default history cap.
     pub fn new(engine: EngineKind, until: f64, frame_time: f64) -> RenderConfig {
         RenderConfig {
             engine,
+            start: 0.0,
+            reverse_at: None,
             until,
             frame_time,
             check: false,
@@ -96,6 +103,19 @@ pub struct Scene {
     pub sectors: Option<Layout>,
     /// How each ball looks: the scenario's colours and labels (a pool ball's number).
     pub looks: Vec<Look>,
+    /// The reversal of the run drawn, if it has one.
+    pub turn: Option<Turn>,
+}
+
+/// A run whose balls all turn around (thesis 4.6), as its pictures show it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Turn {
+    /// When every ball turned around.
+    pub at: f64,
+    /// The time of the last frame, which outlines where each ball started beneath it.
+    pub end: f64,
+    /// Where each ball started (`None` for a ball that started in a pocket).
+    pub starts: Vec<Option<Vec2>>,
 }
 
 /// How a ball looks in pictures.
@@ -122,6 +142,7 @@ impl Scene {
                     label: b.label.clone(),
                 })
                 .collect(),
+            turn: None,
         }
     }
 
@@ -141,6 +162,10 @@ pub struct Shot {
     /// Messages sent by every batch up to and including the frame's time, by thesis type
     /// (objects engines only; the event-list engine sends none).
     pub messages: Option<Vec<(&'static str, u64)>>,
+    /// In a run with a reversal at `r`, for a frame at `r + t` (`t ≥ 0`) whose mirror frame at
+    /// `r - t` exists: the largest distance between a ball on the table now and where it was
+    /// then (how far the run is from retracing its steps).
+    pub mirror_distance: Option<f64>,
 }
 
 /// One piece of a ball's path: from time `from` on, the ball is in `state` (until its next
@@ -180,6 +205,22 @@ impl History {
         }
     }
 
+    /// Adds the reversal at `frame`'s time, shown by that frame (every ball as it is after
+    /// everything at that time, the reversal included): each ball's state from then on, until
+    /// its next event, is the frame's.
+    pub fn turn_at(&mut self, frame: &Frame) {
+        for (path, b) in self.pieces.iter_mut().zip(&frame.balls) {
+            let k = path.partition_point(|p| p.from <= frame.t);
+            path.insert(
+                k,
+                Piece {
+                    from: frame.t,
+                    state: *b,
+                },
+            );
+        }
+    }
+
     /// The number of pieces over all balls.
     pub fn len(&self) -> usize {
         self.pieces.iter().map(Vec::len).sum()
@@ -207,6 +248,10 @@ pub struct Recording {
     pub scene: Scene,
     /// The engine's name (`event-list`, `objects`, …).
     pub engine: &'static str,
+    /// The time of the first frame, where the run started.
+    pub start: f64,
+    /// When every ball turned around, if ever.
+    pub reverse_at: Option<f64>,
     /// End time.
     pub until: f64,
     /// Time between frames.
@@ -294,15 +339,35 @@ impl Observer for Recorder {
     }
 }
 
-/// The times of the frames: `0, F, 2F, …` up to `until`, as the engines compute them.
-pub fn frame_times(until: f64, frame_time: f64) -> Vec<f64> {
-    let span = Span {
-        frame_time: Some(frame_time),
-        ..Span::default()
-    };
+/// The times of the frames of a run over `span` (its frame time set) up to `until`, as the
+/// engines compute them: `0, F, 2F, …` for a run from 0 without a reversal.
+pub fn frame_times(span: Span, until: f64) -> Vec<f64> {
     (0u64..)
         .map_while(|k| span.frame(k).filter(|&t| t <= until))
         .collect()
+}
+
+/// Sets each frame's distance from its mirror frame about the reversal at `r`: for the frame at
+/// `r + t`, the largest distance between a ball on the table then and where it was at `r - t`.
+fn mirror_distances(shots: &mut [Shot], r: f64) {
+    let times: Vec<f64> = shots.iter().map(|s| s.frame.t).collect();
+    for k in 0..shots.len() {
+        let t = times[k] - r;
+        let Some(m) = (t >= 0.0)
+            .then(|| times.iter().position(|&u| u - r == -t))
+            .flatten()
+        else {
+            continue;
+        };
+        let (now, then) = (&shots[k].frame.balls, &shots[m].frame.balls);
+        let far = now
+            .iter()
+            .zip(then)
+            .filter(|(a, b)| a.pocket.is_none() && b.pocket.is_none())
+            .map(|(a, b)| (a.traj.position - b.traj.position).norm())
+            .fold(0.0, f64::max);
+        shots[k].mirror_distance = Some(far);
+    }
 }
 
 /// Checks a frame time and end time, and the size of the recording they would make.
@@ -314,12 +379,13 @@ fn check_sizes(balls: usize, cfg: &RenderConfig) -> Result<(), RunError> {
         )));
     }
     let u = cfg.until;
-    if !(u.is_finite() && u >= 0.0) {
+    if !(u.is_finite() && u >= cfg.start) {
         return Err(RunError::Input(format!(
-            "--until: must be a finite number not below 0, got {u}"
+            "--until: must be a finite number not below {}, got {u}",
+            format_time(cfg.start)
         )));
     }
-    let frames = (u / f).floor() + 1.0;
+    let frames = ((u - cfg.start) / f).floor() + 1.0;
     if frames > MAX_FRAMES as f64 || frames * balls as f64 > MAX_FRAME_BALLS as f64 {
         return Err(RunError::Input(format!(
             "--frame-time: {f} up to {u} makes {frames} frames of {balls} balls, more than the \
@@ -352,9 +418,14 @@ fn messages_of(e: &Objects) -> Vec<(&'static str, u64)> {
 fn chunked(
     scenario: &Scenario,
     engine: EngineKind,
+    span: Span,
     times: &[f64],
 ) -> Result<Option<Vec<(Frame, EventCounts, Vec<(&'static str, u64)>)>>, RunError> {
-    let Some(mut e) = build_objects(scenario, engine, Span::default())? else {
+    let span = Span {
+        frame_time: None,
+        ..span
+    };
+    let Some(mut e) = build_objects(scenario, engine, span)? else {
         return Ok(None);
     };
     let mut counts = EventCounts::default();
@@ -383,7 +454,12 @@ fn chunked(
 /// stopped at each frame time.
 pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunError> {
     check_sizes(scenario.balls.len(), cfg)?;
-    let times = frame_times(cfg.until, cfg.frame_time);
+    let span = Span {
+        start: cfg.start,
+        reverse_at: cfg.reverse_at,
+        frame_time: Some(cfg.frame_time),
+    };
+    let times = frame_times(span, cfg.until);
     let drawn = match (cfg.sectors, cfg.engine) {
         (None, _) => None,
         (Some(_), EngineKind::Sectored { sectors, .. }) | (Some(sectors), _) => {
@@ -391,20 +467,21 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
         }
     };
     let sectored = matches!(cfg.engine, EngineKind::Sectored { .. });
-    let mut rec = Recorder::new(&BallState::initial(scenario, 0.0), cfg.max_history);
+    let initial = BallState::initial(scenario, cfg.start);
+    let mut rec = Recorder::new(&initial, cfg.max_history);
     let run = RunConfig {
         engine: cfg.engine,
         until: cfg.until,
         check: cfg.check,
         span: Span {
             frame_time: (!sectored).then_some(cfg.frame_time),
-            ..Span::default()
+            ..span
         },
         interrupt: None,
         checkpoint_every: None,
     };
     let report = execute(scenario, &run, &mut rec)?;
-    let chunks = chunked(scenario, cfg.engine, &times)?;
+    let chunks = chunked(scenario, cfg.engine, span, &times)?;
     let shots: Vec<Shot> = match chunks {
         Some(chunks) if sectored => chunks
             .into_iter()
@@ -412,6 +489,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
                 frame,
                 events,
                 messages: Some(messages),
+                mirror_distance: None,
             })
             .collect(),
         chunks => {
@@ -422,6 +500,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
                     frame,
                     events,
                     messages: messages.as_mut().and_then(Iterator::next),
+                    mirror_distance: None,
                 })
                 .collect()
         }
@@ -433,13 +512,32 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
             times.len()
         )));
     }
+    let mut shots = shots;
+    let mut history = rec.history;
+    if let Some(r) = cfg.reverse_at {
+        mirror_distances(&mut shots, r);
+        if let (Some(h), Some(at)) = (&mut history, shots.iter().find(|s| s.frame.t == r)) {
+            h.turn_at(&at.frame);
+        }
+    }
+    let mut scene = Scene::new(scenario, drawn);
+    scene.turn = cfg.reverse_at.map(|at| Turn {
+        at,
+        end: shots.last().map_or(cfg.until, |s| s.frame.t),
+        starts: initial
+            .iter()
+            .map(|b| b.pocket.is_none().then_some(b.traj.position))
+            .collect(),
+    });
     Ok(Recording {
-        scene: Scene::new(scenario, drawn),
+        scene,
         engine: cfg.engine.name(),
+        start: cfg.start,
+        reverse_at: cfg.reverse_at,
         until: cfg.until,
         frame_time: cfg.frame_time,
         shots,
-        history: rec.history,
+        history,
         summary: report.summary,
     })
 }
@@ -670,10 +768,42 @@ mod tests {
         assert_eq!(default_frame_time(0.0), 1.0);
     }
 
+    fn every(f: f64) -> Span {
+        Span {
+            frame_time: Some(f),
+            ..Span::default()
+        }
+    }
+
     #[test]
     fn frame_times_reach_until() {
-        assert_eq!(frame_times(3.0, 1.0), vec![0.0, 1.0, 2.0, 3.0]);
-        assert_eq!(frame_times(0.35, 0.1).len(), 4);
+        assert_eq!(frame_times(every(1.0), 3.0), vec![0.0, 1.0, 2.0, 3.0]);
+        assert_eq!(frame_times(every(0.35), 0.1).len(), 1);
+        assert_eq!(frame_times(every(0.1), 0.35).len(), 4);
+    }
+
+    #[test]
+    fn frames_about_a_reversal_are_mirror_images() {
+        // 1.7 is not 17 tenths in floating point: the ends are the start and its mirror exactly
+        for (q, f) in [(3.0, 0.2), (1.7, 0.1), (3.0, 0.1), (1.0, 0.3)] {
+            let span = Span {
+                start: -q,
+                reverse_at: Some(0.0),
+                frame_time: Some(f),
+            };
+            let times = frame_times(span, q);
+            let whole = ((q / f).round() - q / f).abs() < 1e-9;
+            if whole {
+                assert_eq!((times[0], *times.last().unwrap()), (-q, q), "{q} {f}");
+            }
+            assert!(times[0] >= -q && times.contains(&0.0));
+            for t in &times {
+                assert!(
+                    times.contains(&-t),
+                    "{q} {f}: {t} has no mirror in {times:?}"
+                );
+            }
+        }
     }
 
     #[test]

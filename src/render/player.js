@@ -189,6 +189,15 @@
       ? D.sectors.map((s, k) => touches(s, [b.x, b.y], D.balls[i].r) ? k : -1).filter((k) => k >= 0)
       : []);
     let s = '';
+    // a reversal's last frame outlines where each ball started, beneath the balls
+    if (D.turn && t === D.turn.end) {
+      D.turn.starts.forEach((p, i) => {
+        if (p === null) return;
+        const [x, y] = px(p[0], p[1]);
+        s += '<circle class="start" cx="' + n(x) + '" cy="' + n(y) + '" r="' + n(D.balls[i].r * V.scale + 3) +
+          '" fill="none" stroke="' + C.colours.sector + '" stroke-width="1.5" stroke-dasharray="4 3"/>';
+      });
+    }
     balls.forEach((b, i) => {
       if (b.pocket !== null) return;
       const [x, y] = px(b.x, b.y);
@@ -237,11 +246,18 @@
     });
     s += textBlock({ x: V.width / 2, y: 14, h: 'middle', v: 'down' }, ['POOL SIMULATION AT ' + fmtTime(t)], 'title',
       C.colours.text, 22);
+    const mirror = mirrorDistance(t, balls);
+    if (D.turn) {
+      s += textBlock({ x: V.width / 2, y: 40, h: 'middle', v: 'down' }, [turnLine(t, mirror)], 'turn', C.colours.quiet,
+        C.font);
+    }
     s += textBlock({ x: 12, y: V.height - 8, h: 'start', v: 'up' }, countsLines(t, ev, msg), 'counts',
       C.colours.quiet, 11);
     dyn.innerHTML = s;
     unclutter();
-    current = { t: t, balls: balls, events: ev, messages: msg };
+    current = { t: t, balls: balls, events: ev, messages: msg, mirror: mirror };
+    $('mirror').textContent = mirror === null ? '' : '\u2194 ' + fmtDistance(mirror) + ' from t = ' +
+      fmtTime(2 * D.turn.at - t);
     showCounts(ev, msg);
   }
 
@@ -297,16 +313,42 @@
     $('counts').innerHTML = h;
   }
 
+  // ---- the reversal -------------------------------------------------------------------------
+  // After the reversal at r, at r + t: the largest distance between a ball on the table and
+  // where it was at r - t (null before the reversal, or where r - t is before the start).
+  function mirrorDistance(t, balls) {
+    if (!D.turn || t < D.turn.at || 2 * D.turn.at - t < D.start) return null;
+    const then = ballsAt(2 * D.turn.at - t);
+    let far = 0;
+    balls.forEach((b, i) => {
+      const a = then[i];
+      if (b.pocket === null && a.pocket === null) far = Math.max(far, Math.hypot(b.x - a.x, b.y - a.y));
+    });
+    return far;
+  }
+  function fmtDistance(d) { return d === 0 ? '0' : d.toExponential(1); }
+  // As src/render/svg.rs turn_line.
+  function turnLine(t, mirror) {
+    const at = fmtTime(D.turn.at);
+    if (t >= D.turn.at && mirror !== null) {
+      return 'turned around at ' + at + ': the farthest any ball is from where it was at ' +
+        fmtTime(2 * D.turn.at - t) + ' is ' + fmtDistance(mirror);
+    }
+    return t >= D.turn.at ? 'turned around at ' + at : 'every ball turns around at ' + at;
+  }
+
   // ---- controls -----------------------------------------------------------------------------
-  let t = 0, playing = false, last = null;
+  let t = D.start, playing = false, last = null;
   const slider = $('time');
+  slider.min = String(D.start);
   slider.max = String(D.until);
-  slider.step = String(D.until > 0 ? D.until / 4000 : 1);
+  slider.value = String(D.start);
+  slider.step = String(D.until > D.start ? (D.until - D.start) / 4000 : 1);
 
   function seek(x) {
     const v = Number(x);
     if (!isFinite(v)) throw new Error('seek: not a number: ' + x);
-    t = Math.min(D.until, Math.max(0, v));
+    t = Math.min(D.until, Math.max(D.start, v));
     slider.value = String(t);
     $('clock').textContent = fmtTime(t);
     draw(t);
@@ -319,6 +361,7 @@
         pocket: b.pocket === null ? null : D.pocket_names[b.pocket] })),
       events: Object.fromEntries(D.event_kinds.map((k, i) => [k, current.events[i]])),
       messages: current.messages ? current.messages.counts : null,
+      mirror_distance: current.mirror,
       exact: !!H,
     };
   }
@@ -343,7 +386,7 @@
     if (last !== null) {
       let next = t + (now - last) / 1000 * Number($('speed').value);
       if (next >= D.until) {
-        if ($('loop').checked) next = 0; else { next = D.until; pause(); }
+        if ($('loop').checked) next = D.start; else { next = D.until; pause(); }
       }
       seek(next);
     }
@@ -351,7 +394,7 @@
     if (playing) requestAnimationFrame(tick);
   }
   function play() {
-    if (t >= D.until) seek(0);
+    if (t >= D.until) seek(D.start);
     playing = true; last = null; $('play').textContent = 'Pause';
     requestAnimationFrame(tick);
   }
@@ -403,7 +446,7 @@
       pre.hidden = false;
     }
   } else {
-    seek(0);
+    seek(D.start);
     play();
   }
 })();

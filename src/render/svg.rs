@@ -12,7 +12,7 @@
 //! with the ball's name.
 
 use super::text_box::{self, Rect};
-use super::{centroid, format_time, sectors_of, Scene, Shot};
+use super::{centroid, format_time, sectors_of, Scene, Shot, Turn};
 use crate::engine::{BallState, EventKind, Fixed};
 use crate::geometry::Vec2;
 use crate::summary::MessageCounts;
@@ -543,6 +543,9 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
     } else {
         vec![Vec::new(); balls.len()]
     };
+    if let Some(turn) = scene.turn.as_ref().filter(|t| t.end == shot.frame.t) {
+        start_outlines(&mut out, view, turn, balls);
+    }
     ball_circles(&mut out, scene, view, balls);
     if style.vectors {
         velocity_arrows(&mut out, scene, view, balls, style.arrow_time);
@@ -565,8 +568,45 @@ pub fn moving_layer(scene: &Scene, view: &View, shot: &Shot, style: &Style) -> S
         let lines = list_lines(pocket, names);
         text_block(&mut out, &a, &lines, "pocket-label", colour::TEXT, FONT);
     }
-    title_and_counts(&mut out, view, shot);
+    title_and_counts(&mut out, scene, view, shot);
     out
+}
+
+/// Where each ball started, outlined (dashed) beneath the balls: on a reversal's last frame the
+/// eye sees each ball back on its start.
+fn start_outlines(out: &mut String, view: &View, turn: &Turn, balls: &[BallState]) {
+    for (p, b) in turn.starts.iter().zip(balls) {
+        if let Some(p) = p {
+            let (x, y) = view.px(*p);
+            let _ = write!(
+                out,
+                r#"<circle class="start" cx="{}" cy="{}" r="{}" fill="none" stroke="{}" stroke-width="1.5" stroke-dasharray="4 3"/>"#,
+                n(x),
+                n(y),
+                n(b.radius * view.scale + 3.0),
+                colour::SECTOR
+            );
+        }
+    }
+}
+
+/// What a frame of a run with a reversal says under its title: the reversal to come, or, once
+/// it is past, how far the balls are from retracing their steps.
+pub fn turn_line(turn: &Turn, t: f64, mirror_distance: Option<f64>) -> String {
+    let at = format_time(turn.at);
+    match mirror_distance {
+        Some(d) if t >= turn.at => format!(
+            "turned around at {at}: the farthest any ball is from where it was at {} is {}",
+            format_time(2.0 * turn.at - t),
+            if d == 0.0 {
+                "0".to_string()
+            } else {
+                format!("{d:.1e}")
+            }
+        ),
+        _ if t >= turn.at => format!("turned around at {at}"),
+        _ => format!("every ball turns around at {at}"),
+    }
 }
 
 /// Every ball on the table as a circle.
@@ -717,7 +757,7 @@ fn sector_labels(
 }
 
 /// The title, "POOL SIMULATION AT t" (thesis plates), and the counts of events and messages.
-fn title_and_counts(out: &mut String, view: &View, shot: &Shot) {
+fn title_and_counts(out: &mut String, scene: &Scene, view: &View, shot: &Shot) {
     let title = Anchor {
         x: view.width / 2.0,
         y: 14.0,
@@ -732,6 +772,11 @@ fn title_and_counts(out: &mut String, view: &View, shot: &Shot) {
         colour::TEXT,
         22.0,
     );
+    if let Some(turn) = &scene.turn {
+        let under = Anchor { y: 40.0, ..title };
+        let line = turn_line(turn, shot.frame.t, shot.mirror_distance);
+        text_block(out, &under, &[line], "turn", colour::QUIET, FONT);
+    }
     let counts = Anchor {
         x: 12.0,
         y: view.height - 8.0,
