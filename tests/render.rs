@@ -853,8 +853,15 @@ fn reverse_draws_plates_5_and_6_and_a_page() {
         eprintln!("skipped the page: no headless browser");
         return;
     };
+    reversal_page_in_a_browser(browser, &d.join("r.html"), balls);
+}
+
+/// The reversal's page at -3 and 3 shows the balls at the report's `balls`' starts and ends,
+/// at 3 a distance from -3 of almost nothing, at -1 none; its labels are apart and its arrows on
+/// the table.
+fn reversal_page_in_a_browser(browser: &str, page: &Path, balls: &[serde_json::Value]) {
     for (t, end) in [("-3", "start"), ("3", "end"), ("-1", "")] {
-        let (state, console) = browse(browser, &d.join("r.html"), t);
+        let (state, console) = browse(browser, page, t);
         assert!(console.is_empty(), "console at t = {t}: {console:?}");
         if end.is_empty() {
             assert_eq!(state["mirror_distance"], serde_json::Value::Null);

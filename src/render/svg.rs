@@ -756,7 +756,8 @@ fn sector_labels(
     }
 }
 
-/// The title, "POOL SIMULATION AT t" (thesis plates), and the counts of events and messages.
+/// The title, "POOL SIMULATION AT t" (thesis plates), with the reversal's line under it in a run
+/// that has one, and the counts of events and messages.
 fn title_and_counts(out: &mut String, scene: &Scene, view: &View, shot: &Shot) {
     let title = Anchor {
         x: view.width / 2.0,
