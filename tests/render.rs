@@ -12,6 +12,8 @@ use poolsim::summary::MessageCounts;
 use std::path::Path;
 use std::process::Command;
 
+mod common;
+
 /// The sectored objects engine on `grid`.
 fn sectored(grid: SectorChoice) -> EngineKind {
     EngineKind::Sectored {
@@ -726,10 +728,13 @@ fn reversal(engine: EngineKind, frame_time: f64) -> Recording {
 
 #[test]
 fn a_reversal_is_recorded_from_its_start_back_to_it() {
+    // Time Warp on sectors, like the sequential sectored engine, is stopped at each frame time
+    let grid = SectorChoice::Grid(2, 2);
     for engine in [
         EngineKind::EventList,
         OBJECTS,
-        sectored(SectorChoice::Grid(2, 2)),
+        sectored(grid),
+        common::two_workers(Some(grid)),
     ] {
         let rec = reversal(engine, 0.2);
         let times: Vec<f64> = rec.shots.iter().map(|s| s.frame.t).collect();

@@ -460,13 +460,18 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
         frame_time: Some(cfg.frame_time),
     };
     let times = frame_times(span, cfg.until);
-    let drawn = match (cfg.sectors, cfg.engine) {
-        (None, _) => None,
-        (Some(_), EngineKind::Sectored { sectors, .. }) | (Some(sectors), _) => {
-            Some(sector_layout(scenario, sectors)?)
-        }
+    // the sectored engines, sequential or Time Warp, draw their own layout; they draw no
+    // frames themselves, and are stopped at each frame time instead
+    let own = match cfg.engine {
+        EngineKind::Sectored { sectors, .. } => Some(sectors),
+        EngineKind::TimeWarp { sectors, .. } => sectors,
+        _ => None,
     };
-    let sectored = matches!(cfg.engine, EngineKind::Sectored { .. });
+    let drawn = match (cfg.sectors, own) {
+        (None, _) => None,
+        (Some(_), Some(sectors)) | (Some(sectors), None) => Some(sector_layout(scenario, sectors)?),
+    };
+    let sectored = own.is_some();
     let initial = BallState::initial(scenario, cfg.start);
     let mut rec = Recorder::new(&initial, cfg.max_history);
     let run = RunConfig {
