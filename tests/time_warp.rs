@@ -298,6 +298,7 @@ fn an_instant_commits_as_it_goes() {
 fn memory_stays_flat_over_many_gvt_rounds() {
     use pdes_kernel::phold::{Phold, PholdConfig};
     use pdes_kernel::time_warp::threads::TimeWarp;
+    use pdes_kernel::time_warp::ObjectMap;
     use pdes_kernel::VTime;
     let cfg = PholdConfig {
         objects: 512,
@@ -309,13 +310,12 @@ fn memory_stays_flat_over_many_gvt_rounds() {
         seed: 3,
     };
     let (model, states) = Phold::new(cfg);
-    let worker_of: Vec<u32> = (0..512).map(|o| o / 256).collect();
     let tw = TwConfig {
         workers: 2,
         gvt_interval: Some(512),
         ..TwConfig::default()
     };
-    let mut ex = TimeWarp::new(model, states, VTime::start(0.0), &worker_of, tw);
+    let mut ex = TimeWarp::new(model, states, VTime::start(0.0), &ObjectMap::Block, tw);
     ex.run::<()>(200.0, &mut |_, _, _| Ok(())).unwrap();
     let stats = ex.tw_stats();
     assert!(stats.gvt_rounds >= 100, "{stats:?}");

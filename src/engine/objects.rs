@@ -11,7 +11,7 @@ use crate::model::sectored::{Layout, SecState, Sectored};
 use crate::scenario::{BallSpec, Scenario};
 use pdes_kernel::sequential::{Sequential, Sink};
 use pdes_kernel::time_warp::threads::{total_workers, TimeWarp};
-use pdes_kernel::time_warp::{TwConfig, TwStats};
+use pdes_kernel::time_warp::{ObjectMap, TwConfig, TwStats};
 use pdes_kernel::{ExecError, Executor, Interrupt, MessageStats, Model, VTime};
 
 /// The objects engine over one scenario: plain or sectored.
@@ -36,7 +36,10 @@ where
     let start = VTime::start(start);
     match tw {
         None => Box::new(Sequential::new(model, states, start)),
-        Some((cfg, worker_of)) => Box::new(TimeWarp::new(model, states, start, &worker_of, cfg)),
+        Some((cfg, worker_of)) => {
+            let map = ObjectMap::Given(worker_of);
+            Box::new(TimeWarp::new(model, states, start, &map, cfg))
+        }
     }
 }
 

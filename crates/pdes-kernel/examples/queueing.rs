@@ -19,7 +19,7 @@
 use pdes_kernel::digest::fnv_hex;
 use pdes_kernel::sequential::Sequential;
 use pdes_kernel::time_warp::threads::TimeWarp;
-use pdes_kernel::time_warp::TwConfig;
+use pdes_kernel::time_warp::{ObjectMap, TwConfig};
 use pdes_kernel::{Ctx, Envelope, Model, PlainTime, VTime};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -180,8 +180,8 @@ fn main() {
         workers: 2,
         ..TwConfig::default()
     };
-    let worker_of: Vec<u32> = (0..STATIONS).map(|o| o * 2 / STATIONS).collect();
-    let mut tw = TimeWarp::new(Network, stations(), VTime::start(0.0), &worker_of, cfg);
+    let map = ObjectMap::Block;
+    let mut tw = TimeWarp::new(Network, stations(), VTime::start(0.0), &map, cfg);
     if tw.run(UNTIL, &mut { never }).is_err() {
         panic!("Time Warp failed");
     }

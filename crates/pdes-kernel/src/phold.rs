@@ -15,8 +15,8 @@
 
 use crate::digest::fnv_hex;
 use crate::sequential::Sequential;
-use crate::time_warp::threads::{total_workers, TimeWarp};
-use crate::time_warp::{RoundRecord, TwConfig, TwStats};
+use crate::time_warp::threads::TimeWarp;
+use crate::time_warp::{ObjectMap, RoundRecord, TwConfig, TwStats};
 use crate::{Ctx, Envelope, ExecError, Executor, Model, PlainTime, VTime};
 use rand::{Rng, RngCore, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -239,13 +239,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
     let never = |_: &Phold, _: &[PholdState], _: ()| -> Result<(), Infallible> { Ok(()) };
     let mut ex: Box<dyn Executor<Phold, Infallible>> = match tw {
         None => Box::new(Sequential::new(model, states, t0)),
-        Some(c) => {
-            let total = total_workers(&c) as u64;
-            let worker_of: Vec<u32> = (0..objects)
-                .map(|o| (u64::from(o) * total / u64::from(objects)) as u32)
-                .collect();
-            Box::new(TimeWarp::new(model, states, t0, &worker_of, c))
-        }
+        Some(c) => Box::new(TimeWarp::new(model, states, t0, &ObjectMap::Block, c)),
     };
     ex.run(end, &mut { never })?;
     let (stats, finals, time_warp) = (ex.stats().clone(), ex.states().to_vec(), ex.tw_stats());
@@ -409,7 +403,13 @@ mod time_warp_tests {
                     gvt_interval: Some(64),
                     ..Default::default()
                 };
-                let mut tw = TimeWarp::new(model, states, VTime::start(0.0), &worker_of, tw_cfg);
+                let mut tw = TimeWarp::new(
+                    model,
+                    states,
+                    VTime::start(0.0),
+                    &ObjectMap::Given(worker_of),
+                    tw_cfg,
+                );
                 tw.run::<()>(30.0, &mut |_, _, _| Ok(())).unwrap();
                 let a: Vec<(u64, u64)> =
                     seq.states().iter().map(|s| (s.handled, s.sends)).collect();

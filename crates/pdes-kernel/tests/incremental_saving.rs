@@ -5,7 +5,7 @@
 
 use pdes_kernel::sequential::Sequential;
 use pdes_kernel::time_warp::threads::TimeWarp;
-use pdes_kernel::time_warp::TwConfig;
+use pdes_kernel::time_warp::{ObjectMap, TwConfig};
 use pdes_kernel::{Ctx, Envelope, Model, PlainTime, Saving, VTime};
 
 /// Entries in each object's table.
@@ -147,8 +147,7 @@ fn run(workers: Option<TwConfig>, until: f64) -> (Vec<(u32, u64, u64)>, u64, u64
             (ex.states().to_vec(), ex.stats().batches, 0)
         }
         Some(cfg) => {
-            let places: Vec<u32> = (0..32).map(|o| o % cfg.workers as u32).collect();
-            let mut ex = TimeWarp::new(model, books, start, &places, cfg);
+            let mut ex = TimeWarp::new(model, books, start, &ObjectMap::RoundRobin, cfg);
             ex.run(until, &mut sink).unwrap();
             let st = ex.tw_stats();
             assert_eq!(st.committed, ex.stats().batches);

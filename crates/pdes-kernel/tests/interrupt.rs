@@ -4,7 +4,7 @@
 
 use pdes_kernel::sequential::Sequential;
 use pdes_kernel::time_warp::threads::TimeWarp;
-use pdes_kernel::time_warp::TwConfig;
+use pdes_kernel::time_warp::{ObjectMap, TwConfig};
 use pdes_kernel::{Ctx, Envelope, Executor, Interrupt, Model, PlainTime, VTime};
 
 const OBJECTS: u32 = 64;
@@ -87,10 +87,13 @@ fn executor(tw: Option<TwConfig>) -> Box<dyn Executor<Relay, ()>> {
     let start = VTime::start(0.0);
     match tw {
         None => Box::new(Sequential::new(Relay, counts(), start)),
-        Some(cfg) => {
-            let places: Vec<u32> = (0..OBJECTS).map(|o| o % cfg.workers as u32).collect();
-            Box::new(TimeWarp::new(Relay, counts(), start, &places, cfg))
-        }
+        Some(cfg) => Box::new(TimeWarp::new(
+            Relay,
+            counts(),
+            start,
+            &ObjectMap::RoundRobin,
+            cfg,
+        )),
     }
 }
 

@@ -64,6 +64,7 @@ mod config;
 mod fabric;
 mod floor;
 mod log;
+mod map;
 mod marks;
 mod window;
 mod worker;
@@ -74,4 +75,5 @@ pub use config::{
 };
 pub use fabric::{Bounds, Chunk, Committed, CommittedOf, Fabric, Op, OpOf, Progress, Reduction};
 pub use floor::Floor;
+pub use map::ObjectMap;
 pub use worker::{Halt, Placement, Stop, Worker};

@@ -4,7 +4,8 @@
 
 use super::thread_fabric::ThreadFabric;
 use super::{
-    Chunk, CommittedOf, Fabric, Halt, Op, Placement, RoundRecord, TwConfig, TwStats, Worker,
+    Chunk, CommittedOf, Fabric, Halt, ObjectMap, Op, Placement, RoundRecord, TwConfig, TwStats,
+    Worker,
 };
 use crate::executor::ExecError;
 use crate::sequential::Sink;
@@ -205,19 +206,19 @@ where
     M::State: Send + Sync,
     M::Output: Send,
 {
-    /// Places the objects on the workers of every rank (`worker_of[o]` for object `o`, below
-    /// [`total_workers`]) and runs the `init` of this rank's objects at `start`.
+    /// Places the objects on the workers of every rank as `map` says (the [`total_workers`]
+    /// workers numbered rank by rank) and runs the `init` of this rank's objects at `start`.
     pub fn new(
         model: M,
         states: Vec<M::State>,
         start: VTime<M::Time>,
-        worker_of: &[u32],
+        map: &ObjectMap,
         cfg: TwConfig,
     ) -> TimeWarp<M> {
-        assert_eq!(worker_of.len(), states.len(), "one worker per object");
         let (rank, ranks) = place();
         let per = cfg.workers.max(1);
-        let placement = Arc::new(Placement::new(worker_of, per * ranks));
+        let worker_of = map.workers_of(states.len(), per * ranks);
+        let placement = Arc::new(Placement::new(&worker_of, per * ranks));
         let mine = rank * per..(rank + 1) * per;
         // the collector keeps every object's state as it starts; each of this rank's workers
         // copies its own objects on a thread of its own and runs their `init`s there
@@ -680,7 +681,7 @@ mod tests {
             chaos: Some(5),
             ..TwConfig::default()
         };
-        let mut tw = TimeWarp::new(model, states, at(0.0), &worker_of, tw_cfg);
+        let mut tw = TimeWarp::new(model, states, at(0.0), &ObjectMap::Given(worker_of), tw_cfg);
         let (tx, rx) = mpsc::channel();
         let liar = Liar(ThreadFabric::new(2, tx));
         let mut failed: Option<ExecError<()>> = None;
@@ -767,7 +768,7 @@ mod tests {
             workers: 2,
             ..TwConfig::default()
         };
-        let mut tw = TimeWarp::new(model, states, at(0.0), &worker_of, tw_cfg);
+        let mut tw = TimeWarp::new(model, states, at(0.0), &ObjectMap::Given(worker_of), tw_cfg);
         tw.run::<()>(7.0, &mut |_, _, _| Ok(())).unwrap();
         let halfway: Vec<u64> = tw.states().iter().map(|s| s.handled).collect();
         assert!(halfway.iter().sum::<u64>() > 0, "the first leg ran");
@@ -855,13 +856,13 @@ mod tests {
         let want: Vec<u64> = seq.states().iter().map(|s| s.0).collect();
         for workers in [2, 3] {
             for chaos in [None, Some(7), Some(8)] {
-                let worker_of: Vec<u32> = (0..RELAYS).map(|o| o % workers).collect();
                 let cfg = TwConfig {
                     workers: workers as usize,
                     chaos,
                     ..TwConfig::default()
                 };
-                let mut tw = TimeWarp::new(Relay, states.clone(), at(0.0), &worker_of, cfg);
+                let map = ObjectMap::RoundRobin;
+                let mut tw = TimeWarp::new(Relay, states.clone(), at(0.0), &map, cfg);
                 tw.run::<()>(1.0, &mut |_, _, _| Ok(())).unwrap();
                 let got: Vec<u64> = tw.states().iter().map(|s| s.0).collect();
                 let what = format!("{workers} workers, chaos {chaos:?}");
