@@ -29,6 +29,7 @@ pub mod render;
 #[cfg(feature = "pictures")]
 pub mod reversal_study;
 pub mod run;
+pub mod samples;
 pub mod scenario;
 pub mod summary;
 pub mod vtime;

@@ -1033,3 +1033,61 @@ fn runs_too_large_for_memory_are_refused_before_they_allocate() {
     failure(&[&fits[..], &["1M"]].concat(), 2);
     bad_usage(&["run", "gas", "--memory-limit", "lots"]);
 }
+
+#[test]
+fn samples_are_extended_xyz_that_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name).display().to_string();
+    let (xyz, tw_xyz, fin) = (at("s.xyz"), at("tw.xyz"), at("final.json"));
+    let args = ["run", "plate1", "--sample-every", "1", "--quiet", "--json"];
+    let sum = success_json(&[&args[..], &["--samples", &xyz, "--final-state", &fin]].concat());
+    let plain = success_json(&["run", "plate1", "--quiet", "--json"]);
+    assert_eq!(sum["final_state_digest"], plain["final_state_digest"]);
+    let text = std::fs::read_to_string(&xyz).unwrap();
+    let samples = poolsim::samples::read(&text).unwrap();
+    let times: Vec<f64> = samples.iter().map(|s| s.t).collect();
+    assert_eq!(times, [0.0, 1.0, 2.0, 3.0]);
+    assert_eq!(samples[0].size, (600.0, 400.0));
+    // Ball-1 dropped into the pocket at 2.6: the last sample holds Ball-2 alone, where the final
+    // state has it, to the bit
+    let last = &samples[3].balls;
+    assert_eq!((last.len(), last[0].id), (1, 2));
+    let state: Value = serde_json::from_str(&std::fs::read_to_string(&fin).unwrap()).unwrap();
+    let p = &state["balls"][1]["position"];
+    assert_eq!(
+        last[0].position,
+        (p[0].as_f64().unwrap(), p[1].as_f64().unwrap())
+    );
+    // Time Warp samples the same, byte for byte
+    let tw = [
+        "--engine",
+        "time-warp",
+        "--workers",
+        "2",
+        "--samples",
+        &tw_xyz,
+    ];
+    success_json(&[&args[..], &tw[..]].concat());
+    assert_eq!(std::fs::read_to_string(&tw_xyz).unwrap(), text);
+    for (bad, says) in [
+        (
+            vec!["--sample-every", "1"],
+            "--sample-every: only --samples takes samples",
+        ),
+        (
+            vec!["--samples", &xyz, "--sample-every", "-1"],
+            "--sample-every: must be a positive",
+        ),
+        (
+            vec!["--samples", &xyz, "--engine", "objects", "--sectors", "2"],
+            "--samples: the",
+        ),
+        (
+            vec!["--samples", "/nonexistent/dir/s.xyz"],
+            "/nonexistent/dir/s.xyz: cannot write",
+        ),
+    ] {
+        let line = failure(&[&["run", "plate1"][..], &bad[..]].concat(), 2);
+        assert!(line.starts_with(&format!("poolsim: {says}")), "{line}");
+    }
+}

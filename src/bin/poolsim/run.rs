@@ -90,6 +90,13 @@ pub struct RunArgs {
     /// Simulation time between checkpoints.
     #[arg(long = "checkpoint-every", allow_negative_numbers = true)]
     pub checkpoint_every: Option<f64>,
+    /// Write every ball on the table every --sample-every here, as extended XYZ (OVITO, ASE).
+    #[arg(long)]
+    pub samples: Option<PathBuf>,
+    /// Simulation time between samples (default: about 40 samples, rounded to 1, 2 or 5 times
+    /// a power of 10).
+    #[arg(long = "sample-every", allow_negative_numbers = true)]
+    pub sample_every: Option<f64>,
 }
 
 impl RunArgs {
@@ -125,6 +132,8 @@ impl RunArgs {
             memory_limit: None,
             checkpoint: None,
             checkpoint_every: None,
+            samples: None,
+            sample_every: None,
         }
     }
 }
@@ -240,6 +249,7 @@ pub fn check_outputs_apart(a: &RunArgs, resuming: bool) -> Result<(), Failure> {
         ("--trace", &a.trace),
         ("--final-state", &a.final_state),
         ("--checkpoint", &a.checkpoint),
+        ("--samples", &a.samples),
     ];
     for (k, &(flag, out)) in outputs.iter().enumerate() {
         let Some(out) = out else { continue };
@@ -303,7 +313,30 @@ pub fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure
             return Err(usage(format!("{flag}: only the time-warp engine takes it")));
         }
     }
+    if a.sample_every.is_some() && a.samples.is_none() {
+        return Err(usage("--sample-every: only --samples takes samples"));
+    }
+    if a.samples.is_some() && (sectored || matches!(engine, EngineKind::TimeStep { .. })) {
+        return Err(usage(
+            "--samples: the event-list engine, and the objects and time-warp engines without \
+             sectors, take samples",
+        ));
+    }
     Ok(())
+}
+
+/// The time between samples that `--samples` asks for, checked (`None` without it).
+fn sample_every(a: &RunArgs, start: f64, until: f64) -> Result<Option<f64>, Failure> {
+    if a.samples.is_none() {
+        return Ok(None);
+    }
+    match a.sample_every {
+        Some(dt) if !(dt.is_finite() && dt > 0.0) => Err(usage(format!(
+            "--sample-every: must be a positive number, got {dt}"
+        ))),
+        Some(dt) => Ok(Some(dt)),
+        None => Ok(Some(poolsim::render::default_frame_time(until - start))),
+    }
 }
 
 /// Runs `poolsim run`: the scenario on its engine, the trace as it goes, then the final state
@@ -351,6 +384,7 @@ fn config_of(
         check: a.check,
         span: Span {
             start,
+            frame_time: sample_every(a, start, until)?,
             ..Span::default()
         },
         interrupt: None,
@@ -391,14 +425,22 @@ pub fn run_from(
         base: from.map(|c| (c.events, c.initial_energy)),
     });
     let mut progress = Progress::new(cfg.until, a.quiet || !root, a.trace.as_deref());
+    let mut samples = match a.samples.as_ref().filter(|_| root) {
+        Some(p) => Some(Samples::create(p)?),
+        None => None,
+    };
     let report = {
         let mut sinks = Sinks {
             trace: trace.as_mut(),
             progress: progress.as_mut(),
             saver: saver.as_ref(),
+            samples: samples.as_mut(),
         };
         execute(scenario, &cfg, &mut sinks)
     };
+    if let Some(s) = samples {
+        s.finish()?;
+    }
     if let Some(p) = &progress {
         p.bar.finish_and_clear();
     }
@@ -505,11 +547,47 @@ fn write_final_state(
     })
 }
 
-/// Trace, progress and checkpoints, each optional.
+/// Trace, progress, checkpoints and samples, each optional.
 pub struct Sinks<'a> {
     pub trace: Option<&'a mut Trace>,
     pub progress: Option<&'a mut Progress>,
     pub saver: Option<&'a Saver>,
+    pub samples: Option<&'a mut Samples>,
+}
+
+/// The samples file: extended XYZ frames written as the run reaches each sample time. The first
+/// failure to write is kept, and reported once the run is over.
+pub struct Samples {
+    path: PathBuf,
+    out: std::io::BufWriter<std::fs::File>,
+    failed: Option<std::io::Error>,
+}
+
+impl Samples {
+    /// Creates (or empties) the file before the run, so that a path that cannot be written
+    /// fails at once.
+    fn create(path: &std::path::Path) -> Result<Samples, Failure> {
+        let file = std::fs::File::create(path)
+            .map_err(|e| usage(format!("{}: cannot write the samples: {e}", path.display())))?;
+        Ok(Samples {
+            path: path.to_path_buf(),
+            out: std::io::BufWriter::new(file),
+            failed: None,
+        })
+    }
+
+    /// Flushes the file, or reports the first failure to write it.
+    fn finish(mut self) -> Result<(), Failure> {
+        use std::io::Write;
+        let flushed = self.out.flush();
+        match self.failed.map_or(flushed, Err) {
+            Ok(()) => Ok(()),
+            Err(e) => Err(usage(format!(
+                "{}: writing the samples failed: {e}",
+                self.path.display()
+            ))),
+        }
+    }
 }
 
 impl Observer for Sinks<'_> {
@@ -532,6 +610,17 @@ impl Observer for Sinks<'_> {
             Some(s) => s.save(checkpoint, self.trace.as_deref_mut()),
             None => Ok(()),
         }
+    }
+
+    fn on_frame(
+        &mut self,
+        frame: &poolsim::engine::Frame,
+        table: &poolsim::engine::Table,
+    ) -> Result<(), RunError> {
+        if let Some(s) = self.samples.as_deref_mut().filter(|s| s.failed.is_none()) {
+            s.failed = poolsim::samples::write_frame(&mut s.out, frame, table).err();
+        }
+        Ok(())
     }
 }
 

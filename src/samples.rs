@@ -1,0 +1,245 @@
+//! Configurations sampled during a run, as extended XYZ: one frame per sample time, which OVITO,
+//! ASE and most particle tools read.
+//!
+//! Each frame is a count line (the balls on the table), a comment line of `key=value` pairs, and
+//! one line per ball on the table:
+//!
+//! ```text
+//! 2
+//! Lattice="600.0 0.0 0.0 0.0 400.0 0.0 0.0 0.0 1.0" Origin="0.0 0.0 0.0" Properties=species:S:1:pos:R:3:velo:R:3:radius:R:1:mass:R:1:id:I:1 Time=0.5 pbc="F F F"
+//! X 300.0 300.0 0.0 0.0 0.0 0.0 20.0 1.0 1
+//! X 300.0 150.0 0.0 0.0 100.0 0.0 20.0 1.0 2
+//! ```
+//!
+//! The lattice is the table's bounding box (`Origin` its lower left corner; the walls are not
+//! periodic, `pbc="F F F"`); positions and velocities are in the plane `z = 0`. `species` is `X`
+//! (ASE's placeholder element); `id` is the ball's number (`Ball-id`), so that a ball is followed
+//! from frame to frame although balls in pockets are left out. Numbers are written as the
+//! shortest decimals that read back to the same bits.
+
+use crate::engine::{Frame, Table};
+use std::io::{self, Write};
+
+/// The `Properties` of every frame, in column order.
+pub const PROPERTIES: &str = "species:S:1:pos:R:3:velo:R:3:radius:R:1:mass:R:1:id:I:1";
+
+/// Writes `frame` of a run on `table` as one extended XYZ frame.
+pub fn write_frame(out: &mut impl Write, frame: &Frame, table: &Table) -> io::Result<()> {
+    let on_table = frame.balls.iter().filter(|b| b.pocket.is_none()).count();
+    let (lo, span) = (table.lo, table.hi - table.lo);
+    writeln!(out, "{on_table}")?;
+    writeln!(
+        out,
+        "Lattice=\"{:?} 0.0 0.0 0.0 {:?} 0.0 0.0 0.0 1.0\" Origin=\"{:?} {:?} 0.0\" \
+         Properties={PROPERTIES} Time={:?} pbc=\"F F F\"",
+        span.x, span.y, lo.x, lo.y, frame.t
+    )?;
+    for (i, b) in frame.balls.iter().enumerate() {
+        if b.pocket.is_some() {
+            continue;
+        }
+        let (p, v) = (b.traj.at(frame.t), b.traj.velocity);
+        writeln!(
+            out,
+            "X {:?} {:?} 0.0 {:?} {:?} 0.0 {:?} {:?} {}",
+            p.x,
+            p.y,
+            v.x,
+            v.y,
+            b.radius,
+            b.mass,
+            i + 1
+        )?;
+    }
+    Ok(())
+}
+
+/// One frame read back from extended XYZ written by [`write_frame`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    /// Its time (`Time=`).
+    pub t: f64,
+    /// The lattice's lower left corner and its extent along x and y.
+    pub origin: (f64, f64),
+    /// The lattice's extent along x and y.
+    pub size: (f64, f64),
+    /// Each ball on the table: its number, position, velocity, radius and mass.
+    pub balls: Vec<SampledBall>,
+}
+
+/// One ball of a [`Sample`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampledBall {
+    /// Its number (`Ball-id`).
+    pub id: u32,
+    /// Its centre.
+    pub position: (f64, f64),
+    /// Its velocity.
+    pub velocity: (f64, f64),
+    /// Its radius.
+    pub radius: f64,
+    /// Its mass.
+    pub mass: f64,
+}
+
+/// Why extended XYZ text could not be read: the line (from 1) and what is wrong.
+#[derive(Debug, thiserror::Error)]
+#[error("line {line}: {message}")]
+pub struct XyzError {
+    /// The line, counted from 1.
+    pub line: usize,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+/// Reads every frame of extended XYZ text in the columns of [`PROPERTIES`].
+pub fn read(text: &str) -> Result<Vec<Sample>, XyzError> {
+    let mut lines = text.lines().enumerate().map(|(k, l)| (k + 1, l));
+    let mut out = Vec::new();
+    while let Some((k, count)) = lines.next() {
+        if count.trim().is_empty() {
+            continue;
+        }
+        let bad = |line: usize, message: String| XyzError { line, message };
+        let n: usize = count
+            .trim()
+            .parse()
+            .map_err(|_| bad(k, format!("expected a ball count, found `{count}`")))?;
+        let (k, comment) = lines
+            .next()
+            .ok_or_else(|| bad(k + 1, "the frame ends before its comment line".into()))?;
+        let mut sample = comment_of(comment).map_err(|m| bad(k, m))?;
+        for _ in 0..n {
+            let (k, line) = lines
+                .next()
+                .ok_or_else(|| bad(k + 1, format!("the frame ends before its {n} balls")))?;
+            sample.balls.push(ball_of(line).map_err(|m| bad(k, m))?);
+        }
+        out.push(sample);
+    }
+    Ok(out)
+}
+
+/// The time and lattice of a frame's comment line.
+fn comment_of(line: &str) -> Result<Sample, String> {
+    let value = |key: &str| -> Result<&str, String> {
+        let at = line
+            .find(&format!("{key}="))
+            .ok_or_else(|| format!("no {key}= in the comment line"))?;
+        let rest = &line[at + key.len() + 1..];
+        Ok(match rest.strip_prefix('"') {
+            Some(quoted) => &quoted[..quoted.find('"').unwrap_or(quoted.len())],
+            None => rest.split_whitespace().next().unwrap_or(""),
+        })
+    };
+    if value("Properties")? != PROPERTIES {
+        return Err(format!("Properties must be {PROPERTIES}"));
+    }
+    let numbers = |key: &str| -> Result<Vec<f64>, String> {
+        value(key)?
+            .split_whitespace()
+            .map(|x| {
+                x.parse()
+                    .map_err(|_| format!("{key}: `{x}` is not a number"))
+            })
+            .collect()
+    };
+    let (lattice, origin, t) = (numbers("Lattice")?, numbers("Origin")?, numbers("Time")?);
+    if lattice.len() != 9 || origin.len() != 3 || t.len() != 1 {
+        return Err("Lattice needs 9 numbers, Origin 3 and Time 1".into());
+    }
+    Ok(Sample {
+        t: t[0],
+        origin: (origin[0], origin[1]),
+        size: (lattice[0], lattice[4]),
+        balls: Vec::new(),
+    })
+}
+
+/// One ball's line.
+fn ball_of(line: &str) -> Result<SampledBall, String> {
+    let fields: Vec<&str> = line.split_whitespace().collect();
+    if fields.len() != 10 {
+        return Err(format!("expected 10 columns, found {}", fields.len()));
+    }
+    let x = |k: usize| -> Result<f64, String> {
+        fields[k]
+            .parse()
+            .map_err(|_| format!("column {}: `{}` is not a number", k + 1, fields[k]))
+    };
+    let id = fields[9]
+        .parse()
+        .map_err(|_| format!("column 10: `{}` is not a ball number", fields[9]))?;
+    Ok(SampledBall {
+        id,
+        position: (x(1)?, x(2)?),
+        velocity: (x(4)?, x(5)?),
+        radius: x(7)?,
+        mass: x(8)?,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::BallState;
+    use crate::scenario::builtin;
+
+    #[test]
+    fn frames_read_back_to_the_same_bits() {
+        let s = builtin::build("plate1", &builtin::Params::default()).unwrap();
+        let table = Table::new(&s);
+        let mut balls = BallState::initial(&s, 0.0);
+        balls[1].traj.velocity.y = 0.1 + 0.2; // not a short decimal
+        let mut text = Vec::new();
+        let first = Frame { t: 0.0, balls };
+        write_frame(&mut text, &first, &table).unwrap();
+        let mut later = first.clone();
+        later.t = 1.25;
+        later.balls[0].pocket = Some(0);
+        write_frame(&mut text, &later, &table).unwrap();
+        let text = String::from_utf8(text).unwrap();
+        assert!(
+            text.starts_with("2\nLattice=\"600.0 0.0 0.0 0.0 400.0"),
+            "{text}"
+        );
+        let back = read(&text).unwrap();
+        assert_eq!(back.len(), 2);
+        assert_eq!((back[0].t, back[1].t), (0.0, 1.25));
+        assert_eq!((back[0].origin, back[0].size), ((0.0, 0.0), (600.0, 400.0)));
+        for (got, want) in back[0].balls.iter().zip(&first.balls) {
+            assert_eq!(got.position, (want.traj.position.x, want.traj.position.y));
+            assert_eq!(got.velocity, (want.traj.velocity.x, want.traj.velocity.y));
+            assert_eq!((got.radius, got.mass), (want.radius, want.mass));
+        }
+        // the pocketed ball is left out; the other keeps its number and moves on its line
+        assert_eq!(back[1].balls.len(), 1);
+        assert_eq!(back[1].balls[0].id, 2);
+        let moved = first.balls[1].traj.at(1.25);
+        assert_eq!(back[1].balls[0].position, (moved.x, moved.y));
+    }
+
+    #[test]
+    fn bad_text_names_its_line() {
+        let e = read("2\nLattice=\"1 0 0 0 1 0 0 0 1\"\n").unwrap_err();
+        assert_eq!(e.line, 2);
+        let good = format!(
+            "1\nLattice=\"1 0 0 0 1 0 0 0 1\" Origin=\"0 0 0\" Properties={PROPERTIES} Time=0\n"
+        );
+        let e = read(&format!("{good}X 1 2 0 0 0 0 1 1\n")).unwrap_err();
+        assert_eq!(
+            (e.line, e.message.as_str()),
+            (3, "expected 10 columns, found 9")
+        );
+        let e = read(&good).unwrap_err();
+        assert_eq!(e.line, 3);
+        assert!(read("nonsense\n")
+            .unwrap_err()
+            .message
+            .contains("ball count"));
+        assert_eq!(
+            read(&format!("{good}X 1 2 0 0 0 0 1 1 7\n")).unwrap()[0].balls[0].id,
+            7
+        );
+    }
+}
