@@ -18,6 +18,8 @@
 //! shortest decimals that read back to the same bits.
 
 use crate::engine::{Frame, Table};
+use crate::geometry::Vec2;
+use crate::scenario::{BallSpec, CushionSpec, Scenario};
 use std::io::{self, Write};
 
 /// The `Properties` of every frame, in column order.
@@ -67,6 +69,54 @@ pub struct Sample {
     pub balls: Vec<SampledBall>,
 }
 
+impl Sample {
+    /// A scenario that starts from this sample: its balls at time 0 where they are in it, in
+    /// a box of elastic cushions around its lattice, until `until`, named `name`. The balls are
+    /// numbered afresh in the sample's order (a sample leaves out the balls in pockets).
+    pub fn to_scenario(&self, name: &str, until: f64) -> Scenario {
+        let (x0, y0) = self.origin;
+        let (x1, y1) = (x0 + self.size.0, y0 + self.size.1);
+        // clockwise from the left side, so the table lies on each cushion's right
+        let corners = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)].map(|(x, y)| Vec2::new(x, y));
+        Scenario {
+            name: name.to_string(),
+            until,
+            balls: self
+                .balls
+                .iter()
+                .map(|b| BallSpec {
+                    position: Vec2::new(b.position.0, b.position.1),
+                    velocity: Vec2::new(b.velocity.0, b.velocity.1),
+                    radius: b.radius,
+                    mass: b.mass,
+                    fixed: None,
+                    pocket: None,
+                    colour: None,
+                    label: None,
+                })
+                .collect(),
+            cushions: (0..4)
+                .map(|k| CushionSpec {
+                    from: corners[k],
+                    to: corners[(k + 1) % 4],
+                    elasticity: 1.0,
+                })
+                .collect(),
+            pockets: Vec::new(),
+            sectors: None,
+        }
+    }
+}
+
+/// Whether `text` looks like extended XYZ: a count line, then a comment line with `Properties=`.
+pub fn is_xyz(text: &str) -> bool {
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let count = lines
+        .next()
+        .is_some_and(|l| l.trim().parse::<usize>().is_ok());
+    count && lines.next().is_some_and(|l| l.contains("Properties="))
+}
+
 /// One ball of a [`Sample`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampledBall {
@@ -109,11 +159,13 @@ pub fn read(text: &str) -> Result<Vec<Sample>, XyzError> {
             .next()
             .ok_or_else(|| bad(k + 1, "the frame ends before its comment line".into()))?;
         let mut sample = comment_of(comment).map_err(|m| bad(k, m))?;
+        let mut last = k;
         for _ in 0..n {
             let (k, line) = lines
                 .next()
-                .ok_or_else(|| bad(k + 1, format!("the frame ends before its {n} balls")))?;
+                .ok_or_else(|| bad(last + 1, format!("the frame ends before its {n} balls")))?;
             sample.balls.push(ball_of(line).map_err(|m| bad(k, m))?);
+            last = k;
         }
         out.push(sample);
     }
@@ -233,6 +285,15 @@ mod tests {
         );
         let e = read(&good).unwrap_err();
         assert_eq!(e.line, 3);
+        let e = read(&format!(
+            "{}X 1 2 0 0 0 0 1 1 7\n",
+            good.replacen('1', "2", 1)
+        ))
+        .unwrap_err();
+        assert_eq!(
+            (e.line, e.message.as_str()),
+            (4, "the frame ends before its 2 balls")
+        );
         assert!(read("nonsense\n")
             .unwrap_err()
             .message

@@ -1091,3 +1091,39 @@ fn samples_are_extended_xyz_that_reads_back() {
         assert!(line.starts_with(&format!("poolsim: {says}")), "{line}");
     }
 }
+
+#[test]
+fn a_run_starts_from_its_last_sample_as_from_its_final_state() {
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name).display().to_string();
+    let (xyz, fin) = (at("s.xyz"), at("f.json"));
+    let first = ["run", "gas", "--balls", "16", "--until", "2", "--quiet"];
+    let outputs = [
+        "--samples",
+        &xyz,
+        "--sample-every",
+        "1",
+        "--final-state",
+        &fin,
+    ];
+    success(&[&first[..], &outputs[..]].concat());
+    // the gas's table is a box: the sample's lattice gives the same cushions
+    let digest = |start: &str| {
+        success_json(&["run", start, "--until", "1", "--quiet", "--json"])["final_state_digest"]
+            .clone()
+    };
+    assert_eq!(digest(&xyz), digest(&fin));
+    let bad = at("bad.xyz");
+    let head = "Lattice=\"9 0 0 0 9 0 0 0 1\" Origin=\"0 0 0\" Properties=";
+    let props = poolsim::samples::PROPERTIES;
+    std::fs::write(
+        &bad,
+        format!("2\n{head}{props} Time=0\nX 1 2 0 0 0 0 1 1 1\n"),
+    )
+    .unwrap();
+    let line = failure(&["run", &bad], 2);
+    assert!(
+        line.ends_with("bad.xyz:4: not samples poolsim reads: the frame ends before its 2 balls"),
+        "{line}"
+    );
+}

@@ -95,6 +95,8 @@ pub fn load_from(reader: impl Read, source: &str) -> Result<Scenario, ScenarioEr
         )),
         // no TOML starts with a brace: this is a final state (JSON) to start from
         Ok(_) if text.trim_start().starts_with('{') => from_final_state(&text, source),
+        // nor with a count line: samples (extended XYZ) to start from
+        Ok(_) if crate::samples::is_xyz(&text) => from_samples(&text, source),
         Ok(_) => parse(&text, source),
     }
 }
@@ -117,6 +119,29 @@ fn from_final_state(text: &str, source: &str) -> Result<Scenario, ScenarioError>
     };
     let s = state.to_scenario(source, DEFAULT_UNTIL).map_err(fail)?;
     s.validate().map_err(fail)?;
+    Ok(s)
+}
+
+/// The scenario that starts from the last sample of a samples file (`poolsim run --samples`,
+/// extended XYZ): its balls at time 0 where they are in it, in a box of elastic cushions around
+/// its lattice, until [`DEFAULT_UNTIL`].
+fn from_samples(text: &str, source: &str) -> Result<Scenario, ScenarioError> {
+    let samples = crate::samples::read(text).map_err(|e| ScenarioError {
+        source: source.to_string(),
+        line: Some(e.line),
+        field: String::new(),
+        message: format!("not samples poolsim reads: {}", e.message),
+    })?;
+    let last = samples
+        .last()
+        .ok_or_else(|| io_error(source, "no sample in it".into()))?;
+    let s = last.to_scenario(source, DEFAULT_UNTIL);
+    s.validate().map_err(|e| ScenarioError {
+        source: source.to_string(),
+        line: None,
+        field: e.field,
+        message: e.message,
+    })?;
     Ok(s)
 }
 
