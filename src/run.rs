@@ -283,6 +283,16 @@ pub fn build_objects(
                 "the sectored engine draws no frames itself (poolsim render does)".into(),
             ));
         }
+        // sectors cover the table alone: two balls that left it through a gap would meet in no
+        // sector, unseen, where the event list sees them collide
+        if !scenario.is_closed() {
+            return Err(RunError::Input(
+                "--sectors: a sectored run needs a closed table (this one has a gap: a ball that \
+                 leaves through it leaves every sector, where the engine cannot see it meet \
+                 another); run it without sectors"
+                    .into(),
+            ));
+        }
         let mut layout = sector_layout(scenario, sectors)?;
         layout.fixed_news = news;
         Ok(layout)

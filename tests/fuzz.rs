@@ -210,6 +210,8 @@ fn run_everywhere(s: &Scenario, text: &str, closed: bool) -> Result<(), TestCase
         let got = digest(s, engine, false);
         match (&reference, &got) {
             (Ok(want), Ok(have)) => prop_assert_eq!(want, have, "{} differs\n{}", name, text),
+            // sectors cover a closed table alone
+            (Ok(_), Err(RunError::Input(e))) if !closed && e.starts_with("--sectors:") => {}
             (Ok(_), Err(e)) => {
                 return Err(TestCaseError::fail(format!("{name}: {e}\n{text}")));
             }
@@ -261,4 +263,32 @@ fn a_tiny_ball_at_a_far_cushion_passes_the_check() {
         [[cushion]]\nfrom = [400.0, 0.0]\nto = [0.0, 0.0]\n";
     let s = parse(text, SOURCE).unwrap();
     run_everywhere(&s, text, true).unwrap();
+}
+
+/// Found by the fuzz target: on a table open at the bottom, two balls leave through the gap and
+/// meet below it. The event list sees them collide; sectors cover the table alone, so the
+/// sectored engines did not, and ended elsewhere. They now refuse an open table in one line.
+#[test]
+fn two_balls_that_meet_outside_an_open_table_are_no_sectored_run() {
+    let text = "[[ball]]\nposition = [77.34087969802017, 20.0]\nradius = 1.0\n\
+        velocity = [-3.91102269536947, -18.52239980369066]\n\
+        [[ball]]\nposition = [71.0, 77.0]\nradius = 1.0\n\
+        velocity = [-59.266119903076294, -43.70839063130629]\n\
+        [[cushion]]\nfrom = [0.0, 0.0]\nto = [0.0, 400.0]\n\
+        [[cushion]]\nfrom = [0.0, 400.0]\nto = [400.0, 400.0]\n\
+        [[cushion]]\nfrom = [400.0, 400.0]\nto = [400.0, 0.0]\n";
+    let s = parse(text, SOURCE).unwrap();
+    assert!(!s.is_closed());
+    let sectored = EngineKind::Sectored {
+        sectors: SectorChoice::Auto,
+        news: FixedNews::Near,
+    };
+    match digest(&s, sectored, false) {
+        Err(RunError::Input(e)) => {
+            assert!(e.starts_with("--sectors: a sectored run needs a closed table"))
+        }
+        other => panic!("{other:?}"),
+    }
+    // the plain objects engine has no sectors: it agrees with the event list
+    run_everywhere(&s, text, false).unwrap();
 }

@@ -476,6 +476,12 @@ impl Scenario {
         Ok(())
     }
 
+    /// Whether the table's cushions and pockets close into loops, leaving no gap a ball could
+    /// leave the table through.
+    pub fn is_closed(&self) -> bool {
+        self.closed_edges().is_some()
+    }
+
     /// The table's edges if they close into loops (every end of an edge meets an end of another,
     /// whichever way each runs); `None` where they leave gaps: an open table has no inside to
     /// check balls against.
