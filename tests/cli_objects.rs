@@ -163,6 +163,19 @@ fn reverse_model_and_phold() {
     ]));
     assert_eq!(p["committed"], again["committed"]);
     bad(&["phold", "--remote", "1.5"], "--remote");
+    // Time Warp gives the sequential kernel's digest on either placement; round robin sends
+    // most messages between the workers
+    let small = ["phold", "--objects", "64", "--end", "5", "--json"];
+    let seq = json(&poolsim(&small));
+    let mut remote = Vec::new();
+    for map in ["block", "round-robin"] {
+        let tw = ["--engine", "time-warp", "--workers", "2", "--map", map];
+        let r = json(&poolsim(&[&small[..], &tw[..]].concat()));
+        assert_eq!(r["final_state_digest"], seq["final_state_digest"], "{map}");
+        remote.push(r["time_warp"]["remote_messages"].as_u64().unwrap());
+    }
+    assert!(remote[1] > 2 * remote[0], "{remote:?}");
+    bad(&["phold", "--map", "block"], "--map");
 }
 
 #[test]

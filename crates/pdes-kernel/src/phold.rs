@@ -227,6 +227,17 @@ pub enum PholdError {
 /// worker when the partitions match the workers. Fails only when Time Warp does (its memory
 /// budget).
 pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdReport, PholdError> {
+    run_on(cfg, end, tw, &ObjectMap::Block)
+}
+
+/// [`run`] with Time Warp's objects placed on its workers by `map` ([`ObjectMap::Block`] puts
+/// each partition on one worker when the partitions match the workers).
+pub fn run_on(
+    cfg: PholdConfig,
+    end: f64,
+    tw: Option<TwConfig>,
+    map: &ObjectMap,
+) -> Result<PholdReport, PholdError> {
     let start = std::time::Instant::now();
     let (objects, events_per_object, remote, partitions) = (
         cfg.objects,
@@ -239,7 +250,7 @@ pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdRepo
     let never = |_: &Phold, _: &[PholdState], _: ()| -> Result<(), Infallible> { Ok(()) };
     let mut ex: Box<dyn Executor<Phold, Infallible>> = match tw {
         None => Box::new(Sequential::new(model, states, t0)),
-        Some(c) => Box::new(TimeWarp::new(model, states, t0, &ObjectMap::Block, c)),
+        Some(c) => Box::new(TimeWarp::new(model, states, t0, map, c)),
     };
     ex.run(end, &mut { never })?;
     let (stats, finals, time_warp) = (ex.stats().clone(), ex.states().to_vec(), ex.tw_stats());

@@ -11,6 +11,15 @@ pub enum PholdEngine {
     TimeWarp,
 }
 
+/// `poolsim phold --map`: how Time Warp places the objects on its workers.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PholdMap {
+    /// A contiguous block of objects per worker: each partition on one worker.
+    Block,
+    /// Objects dealt out in turn: every partition spread over every worker.
+    RoundRobin,
+}
+
 /// Arguments of `poolsim phold`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct PholdArgs {
@@ -33,6 +42,10 @@ pub struct PholdArgs {
     /// Time Warp workers per rank (default: this machine's cores).
     #[arg(long)]
     pub workers: Option<usize>,
+    /// Time Warp: how objects are placed on the workers (block keeps each partition on one
+    /// worker; round-robin spreads them, so most messages cross between workers).
+    #[arg(long, value_enum)]
+    pub map: Option<PholdMap>,
     /// Time Warp: run every batch as undoable (no final batches), to measure optimism alone.
     #[arg(long = "tw-pure")]
     pub tw_pure: bool,
@@ -98,6 +111,7 @@ fn check_values(a: &PholdArgs) -> Result<(), Failure> {
 /// Runs `poolsim phold` and prints its report (on rank 0 under MPI).
 pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
     use pdes_kernel::phold::run;
+    use pdes_kernel::time_warp::ObjectMap;
     check_values(a)?;
     let tw = tw_config(a)?;
     if tw.is_some() {
@@ -122,7 +136,12 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
     } else {
         None
     };
-    let mut report = run(cfg, a.end, tw).map_err(|e| internal(e.to_string()))?;
+    let map = match a.map {
+        Some(PholdMap::RoundRobin) => ObjectMap::RoundRobin,
+        Some(PholdMap::Block) | None => ObjectMap::Block,
+    };
+    let mut report =
+        pdes_kernel::phold::run_on(cfg, a.end, tw, &map).map_err(|e| internal(e.to_string()))?;
     if rank != 0 {
         return Ok(());
     }
@@ -154,6 +173,7 @@ fn tw_config(a: &PholdArgs) -> Result<Option<pdes_kernel::time_warp::TwConfig>, 
     }
     for (flag, given) in [
         ("--workers", a.workers.is_some()),
+        ("--map", a.map.is_some()),
         ("--tw-pure", a.tw_pure),
         ("--tw-burst", a.tw_burst.is_some()),
         ("--stats", a.stats.is_some()),
