@@ -5,8 +5,8 @@
 
 use poolsim::geometry::Vec2;
 use poolsim::model::pool::NvDelay;
-use poolsim::output::{TraceLine, TraceRecorder};
-use poolsim::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
+use poolsim::output::TraceLine;
+use poolsim::run::{EngineKind, FixedNews, SectorChoice};
 use poolsim::scenario::{builtin, BallSpec, CushionSpec, Scenario};
 use rand::{Rng, SeedableRng};
 
@@ -204,32 +204,13 @@ fn a_cluster_that_forms_and_flies_apart_is_followed_by_the_grid() {
         ..Default::default()
     };
     let s = builtin::build("implosion", &p).unwrap();
-    let mut rec = TraceRecorder::default();
-    let cfg = RunConfig {
-        engine: EngineKind::EventList,
-        until: s.until,
-        check: true,
-        span: Default::default(),
-        interrupt: None,
-        checkpoint_every: None,
-    };
-    let report = execute(&s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{e}"));
-    let stat = |name: &str| {
-        let found = report.outcome.engine_stats.iter().find(|(k, _)| *k == name);
-        found.expect("reported").1
-    };
-    assert!(
-        stat("grid_layouts") >= 2.0,
-        "{:?}",
-        report.outcome.engine_stats
-    );
+    let (_, summary) = common::traced(&s, EngineKind::EventList, true);
+    let stats = &summary.engine_stats;
+    let stat = |name: &str| *stats.get(name).expect("reported");
+    assert!(stat("grid_layouts") >= 2.0, "{stats:?}");
     // the cluster's events are most of the run, and a cluster at area fraction 0.5 in cells of
     // at most 8 balls tests few pairs per prediction
-    let events = report.summary.events.total as f64;
+    let events = summary.events.total as f64;
     assert!(events > 10_000.0, "{events} events");
-    assert!(
-        stat("predictions") < 200.0 * events,
-        "{:?}",
-        report.outcome.engine_stats
-    );
+    assert!(stat("predictions") < 200.0 * events, "{stats:?}");
 }

@@ -504,6 +504,20 @@ fn chromium() -> Option<&'static str> {
     })
 }
 
+/// The headless browser, or `None` after saying that the test skips the browser. CI installs
+/// Chromium and sets POOLSIM_REQUIRE_BROWSER, so there this never skips.
+fn browser_or_skip() -> Option<&'static str> {
+    let found = chromium();
+    if found.is_none() {
+        assert!(
+            std::env::var_os("POOLSIM_REQUIRE_BROWSER").is_none(),
+            "POOLSIM_REQUIRE_BROWSER is set but no headless Chromium was found"
+        );
+        eprintln!("skipped the browser: no headless browser (install Debian's `chromium` package)");
+    }
+    found
+}
+
 /// Opens `page` at `?t=T&dump=1` in headless Chromium: the state the page wrote into
 /// `#poolsim-state`, and every console message it logged.
 fn browse(browser: &str, page: &Path, t: &str) -> (serde_json::Value, Vec<String>) {
@@ -547,15 +561,7 @@ fn browse(browser: &str, page: &Path, t: &str) -> (serde_json::Value, Vec<String
 
 #[test]
 fn the_page_in_a_browser_shows_the_trace_s_positions() {
-    let Some(browser) = chromium() else {
-        // CI installs Chromium and sets POOLSIM_REQUIRE_BROWSER, so there this never skips.
-        assert!(
-            std::env::var_os("POOLSIM_REQUIRE_BROWSER").is_none(),
-            "POOLSIM_REQUIRE_BROWSER is set but no headless Chromium was found"
-        );
-        eprintln!(
-            "skipped: no headless browser (install Debian's `chromium` package to run this test)"
-        );
+    let Some(browser) = browser_or_skip() else {
         return;
     };
     let dir = tempfile::tempdir().expect("a temporary folder");
@@ -620,12 +626,7 @@ fn the_page_in_a_browser_shows_the_trace_s_positions() {
 /// the break, and 10^4 balls (whose vectors are off by default).
 #[test]
 fn the_page_s_layout_keeps_labels_apart_and_arrows_on_the_table() {
-    let Some(browser) = chromium() else {
-        assert!(
-            std::env::var_os("POOLSIM_REQUIRE_BROWSER").is_none(),
-            "POOLSIM_REQUIRE_BROWSER is set but no headless Chromium was found"
-        );
-        eprintln!("skipped: no headless browser");
+    let Some(browser) = browser_or_skip() else {
         return;
     };
     let dir = tempfile::tempdir().expect("a temporary folder");
@@ -850,12 +851,7 @@ fn reverse_draws_plates_5_and_6_and_a_page() {
         &[],
     );
     assert_eq!(out.status.code(), Some(0), "{out:?}");
-    let Some(browser) = chromium() else {
-        assert!(
-            std::env::var_os("POOLSIM_REQUIRE_BROWSER").is_none(),
-            "POOLSIM_REQUIRE_BROWSER is set but no headless Chromium was found"
-        );
-        eprintln!("skipped the page: no headless browser");
+    let Some(browser) = browser_or_skip() else {
         return;
     };
     reversal_page_in_a_browser(browser, &d.join("r.html"), balls);

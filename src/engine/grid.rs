@@ -259,10 +259,11 @@ impl Grid {
     }
 
     /// An empty grid laid out for balls whose centres are now at `centres` (those on the table),
-    /// or `None` if the present layout still suits them. A finer layout suits them once a cell
-    /// of this one has overflowed its slots (a cluster has formed): the coarsest finer one where
-    /// no cell holds more than [`CROWDED`]. A coarser layout suits them if no cell of it holds
-    /// more than [`CROWDED`] (a cluster has spread out): the coarsest such.
+    /// or `None` if the present layout still suits them. Once a cell of this layout has
+    /// overflowed its slots (a cluster has formed), the coarsest layout no coarser than this one
+    /// where no cell holds more than [`CROWDED`] (the finest if none), so this one if the balls
+    /// have moved apart again. Otherwise, the coarsest coarser layout where no cell holds more
+    /// than [`CROWDED`] (a cluster has spread out), if any.
     pub fn relaid(&mut self, table: &Table, centres: &[Vec2]) -> Option<Grid> {
         let last = self.layouts.dims.len() - 1;
         let level = if std::mem::take(&mut self.crowded) {
@@ -955,6 +956,16 @@ mod tests {
         }
     }
 
+    /// 400 centres on a 20 x 20 square lattice `spacing` apart from `corner`.
+    fn square(corner: f64, spacing: f64) -> Vec<Vec2> {
+        (0..400)
+            .map(|k| {
+                let (i, j) = ((k % 20) as f64, (k / 20) as f64);
+                Vec2::new(corner + spacing * i, corner + spacing * j)
+            })
+            .collect()
+    }
+
     /// Places `centres` in a grid as an engine does, and returns the grid's cell for each.
     fn place(g: &mut Grid, centres: &[Vec2]) -> Vec<u32> {
         (0..centres.len() as u32)
@@ -968,14 +979,7 @@ mod tests {
         // dense layout of about 1,600 cells suits them
         let n = 400;
         let t = table(n, 4000.0);
-        let spread: Vec<Vec2> = (0..n)
-            .map(|k| {
-                Vec2::new(
-                    100.0 + 200.0 * (k % 20) as f64,
-                    100.0 + 200.0 * (k / 20) as f64,
-                )
-            })
-            .collect();
+        let spread = square(100.0, 200.0);
         let mut g = Grid::new(&t, &spread, 1.0, 2.0);
         assert!(!g.is_hashed() && g.is_coarsest());
         place(&mut g, &spread);
@@ -983,14 +987,7 @@ mod tests {
         assert!(g.relaid(&t, &spread).is_none(), "nothing coarser exists");
         // the balls gather into a 20 x 20 square 3 apart: a cell overflows, and the finer layout
         // chosen holds at most CROWDED balls in a cell
-        let cluster: Vec<Vec2> = (0..n)
-            .map(|k| {
-                Vec2::new(
-                    2000.0 + 3.0 * (k % 20) as f64,
-                    2000.0 + 3.0 * (k / 20) as f64,
-                )
-            })
-            .collect();
+        let cluster = square(2000.0, 3.0);
         for i in 0..n as u32 {
             g.move_to(i, cluster[i as usize]);
         }

@@ -262,14 +262,19 @@ impl Span {
             return Some(self.start + k as f64 * f);
         };
         let q = r - self.start;
-        let m = (q / f).round();
-        let whole = (q / f - m).abs() <= 1e-9 * m.abs().max(1.0);
-        let j = if whole { -m } else { (-q / f).ceil() } + k as f64;
-        Some(if whole && j.abs() == m {
-            r + j.signum() * q
-        } else {
-            r + j * f
+        let whole = Span::whole_frames(q, f);
+        let j = whole.map_or((-q / f).ceil(), |m| -m) + k as f64;
+        Some(match whole {
+            Some(m) if j.abs() == m => r + j.signum() * q,
+            _ => r + j * f,
         })
+    }
+
+    /// The number of frame times `f` in the span `q`, if it is a whole number (to 1e-9 of it):
+    /// then frames on a grid through a reversal reach a start `q` before it exactly.
+    pub fn whole_frames(q: f64, f: f64) -> Option<f64> {
+        let m = (q / f).round();
+        ((q / f - m).abs() <= 1e-9 * m.abs().max(1.0)).then_some(m)
     }
 }
 

@@ -250,8 +250,6 @@ pub struct Recording {
     pub engine: &'static str,
     /// The time of the first frame, where the run started.
     pub start: f64,
-    /// When every ball turned around, if ever.
-    pub reverse_at: Option<f64>,
     /// End time.
     pub until: f64,
     /// Time between frames.
@@ -352,11 +350,11 @@ pub fn frame_times(span: Span, until: f64) -> Vec<f64> {
 fn mirror_distances(shots: &mut [Shot], r: f64) {
     let times: Vec<f64> = shots.iter().map(|s| s.frame.t).collect();
     for k in 0..shots.len() {
+        // frame times are in order and finite: the mirror's is found by bisection (as a number:
+        // the mirror of 0 is -0)
         let t = times[k] - r;
-        let Some(m) = (t >= 0.0)
-            .then(|| times.iter().position(|&u| u - r == -t))
-            .flatten()
-        else {
+        let mirror = times.binary_search_by(|&u| (u - r).partial_cmp(&-t).expect("finite"));
+        let Some(m) = mirror.ok().filter(|_| t >= 0.0) else {
             continue;
         };
         let (now, then) = (&shots[k].frame.balls, &shots[m].frame.balls);
@@ -538,7 +536,6 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
         scene,
         engine: cfg.engine.name(),
         start: cfg.start,
-        reverse_at: cfg.reverse_at,
         until: cfg.until,
         frame_time: cfg.frame_time,
         shots,

@@ -124,10 +124,7 @@ fn frame_time(a: &ReverseArgs, engine: EngineKind) -> Result<Option<f64>, Failur
             "--out: reverse draws with event-list, objects or time-warp",
         ));
     }
-    let whole = |f: f64| {
-        let m = (a.quit / f).round();
-        m >= 1.0 && (a.quit / f - m).abs() <= 1e-9 * m
-    };
+    let whole = |f: f64| poolsim::engine::Span::whole_frames(a.quit, f).is_some_and(|m| m >= 1.0);
     match a.frame_time {
         Some(f) if !(f.is_finite() && f > 0.0) => Err(usage(format!(
             "--frame-time: must be a positive number, got {f}"
