@@ -179,6 +179,58 @@ fn reverse_model_and_phold() {
 }
 
 #[test]
+fn phold_on_the_conservative_executor_gives_the_sequential_digest() {
+    let small = [
+        "phold",
+        "--objects",
+        "96",
+        "--partitions",
+        "2",
+        "--end",
+        "8",
+        "--json",
+    ];
+    let seq = json(&poolsim(&small));
+    for (workers, map) in [("1", "block"), ("2", "block"), ("3", "round-robin")] {
+        let c = [
+            "--engine",
+            "conservative",
+            "--workers",
+            workers,
+            "--map",
+            map,
+        ];
+        let r = json(&poolsim(
+            &[&small[..], &c[..], &["--baseline"][..]].concat(),
+        ));
+        let what = format!("{workers} workers, {map}");
+        assert_eq!(r["engine"], "conservative", "{what}");
+        assert_eq!(r["final_state_digest"], seq["final_state_digest"], "{what}");
+        assert_eq!(r["committed"], seq["committed"], "{what}");
+        let c = &r["conservative"];
+        let batches: u64 = c["batches"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| b.as_u64().unwrap())
+            .sum();
+        assert_eq!(c["batches"].as_array().unwrap().len().to_string(), workers);
+        assert!(batches > 0 && c["windows"].as_u64().unwrap() > 0, "{r}");
+        assert!(r["speedup"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    // no lookahead, no window: the user is told to take another executor
+    bad(
+        &["phold", "--engine", "conservative", "--lookahead", "0"],
+        "--engine conservative: the conservative executor needs a model with a positive \
+         lookahead",
+    );
+    bad(
+        &["phold", "--engine", "conservative", "--tw-burst", "8"],
+        "--tw-burst: only the time-warp engine takes it",
+    );
+}
+
+#[test]
 fn phold_writes_one_line_of_statistics_per_gvt_round() {
     let path = std::env::temp_dir().join(format!("poolsim-rounds-{}.jsonl", std::process::id()));
     let p = path.to_str().unwrap();
@@ -229,7 +281,10 @@ fn phold_writes_one_line_of_statistics_per_gvt_round() {
     assert!(last.0 > 20.0);
     assert_eq!(last.1, tw["committed"].as_u64().unwrap());
     bad(&["phold", "--stats", p], "only the time-warp engine");
-    bad(&["phold", "--baseline"], "only the time-warp engine");
+    bad(
+        &["phold", "--baseline"],
+        "only a parallel engine (time-warp, conservative)",
+    );
     bad(
         &[
             "phold",

@@ -1,6 +1,7 @@
-//! One interface for every executor: a caller sets a model up on the [`Sequential`] executor or
-//! on [`TimeWarp`], then runs and reads it the same way, whichever it chose.
+//! One interface for every executor: a caller sets a model up on the [`Sequential`] executor,
+//! on [`TimeWarp`] or on [`Conservative`], then runs and reads it the same way, whichever it chose.
 
+use crate::conservative::{Conservative, ConservativeStats};
 use crate::sequential::{Sequential, Sink};
 use crate::time_warp::threads::TimeWarp;
 use crate::time_warp::{RoundRecord, TwStats};
@@ -34,6 +35,11 @@ pub trait Executor<M: Model, E> {
 
     /// Time Warp's own statistics, where the executor is Time Warp.
     fn tw_stats(&self) -> Option<TwStats> {
+        None
+    }
+
+    /// The conservative executor's own statistics, where the executor is that one.
+    fn conservative_stats(&self) -> Option<ConservativeStats> {
         None
     }
 
@@ -133,5 +139,45 @@ where
 
     fn free(self: Box<Self>) {
         TimeWarp::free(*self);
+    }
+}
+
+impl<M, E> Executor<M, E> for Conservative<M>
+where
+    M: Model + Sync,
+    M::Msg: Send,
+    M::State: Send,
+    M::Output: Send,
+{
+    fn model(&self) -> &M {
+        Conservative::model(self)
+    }
+
+    fn states(&self) -> &[M::State] {
+        Conservative::states(self)
+    }
+
+    fn stats(&self) -> &MessageStats {
+        Conservative::stats(self)
+    }
+
+    fn pending_len(&self) -> usize {
+        Conservative::pending_len(self)
+    }
+
+    fn conservative_stats(&self) -> Option<ConservativeStats> {
+        Some(Conservative::conservative_stats(self))
+    }
+
+    fn observe_states(&mut self, on: bool) {
+        self.ship_states(on);
+    }
+
+    fn stop_on(&mut self, interrupt: Interrupt) {
+        Conservative::stop_on(self, interrupt);
+    }
+
+    fn run(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, ExecError<E>> {
+        Conservative::run(self, until, sink)
     }
 }

@@ -26,6 +26,7 @@
 
 #![warn(missing_docs)]
 
+pub mod conservative;
 pub mod digest;
 pub mod executor;
 pub mod interrupt;

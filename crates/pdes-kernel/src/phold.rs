@@ -13,6 +13,7 @@
 //! the range of ROSS's and ROOT-Sim's PHOLD objects, so that saving one costs what it costs
 //! them.
 
+use crate::conservative::{Conservative, ConservativeConfig, ConservativeStats, Refused};
 use crate::digest::fnv_hex;
 use crate::sequential::Sequential;
 use crate::time_warp::threads::TimeWarp;
@@ -178,7 +179,7 @@ pub struct PholdReport {
     pub partitions: u32,
     /// End time.
     pub end: f64,
-    /// Executor: `objects` (sequential) or `time-warp`.
+    /// Executor: `objects` (sequential), `time-warp` or `conservative`.
     pub engine: &'static str,
     /// Events (messages handled) committed.
     pub committed: u64,
@@ -194,6 +195,8 @@ pub struct PholdReport {
     pub final_state_digest: String,
     /// Time Warp's statistics, under Time Warp.
     pub time_warp: Option<TwStats>,
+    /// The conservative executor's statistics, under it.
+    pub conservative: Option<ConservativeStats>,
     /// Seconds the sequential kernel took for the same model in the same invocation, when the
     /// caller ran it as a baseline ([`PholdReport::against`]).
     pub sequential_wall_seconds: Option<f64>,
@@ -221,22 +224,40 @@ pub enum PholdError {
     /// The executor failed (Time Warp out of its memory budget).
     #[error(transparent)]
     Exec(#[from] ExecError<Infallible>),
+    /// The conservative executor refused the model (no lookahead).
+    #[error(transparent)]
+    Refused(#[from] Refused),
+}
+
+/// Which executor runs PHOLD, and how a parallel one places the objects on its workers
+/// ([`ObjectMap::Block`] puts each partition on one worker when the partitions match the
+/// workers).
+#[derive(Clone, Debug)]
+pub enum PholdExecutor {
+    /// The sequential kernel.
+    Sequential,
+    /// Time Warp.
+    TimeWarp(TwConfig, ObjectMap),
+    /// The conservative executor (refused at lookahead 0).
+    Conservative(ConservativeConfig, ObjectMap),
 }
 
 /// Runs PHOLD up to time `end`, sequentially or (with `tw`) under Time Warp, one partition per
 /// worker when the partitions match the workers. Fails only when Time Warp does (its memory
 /// budget).
 pub fn run(cfg: PholdConfig, end: f64, tw: Option<TwConfig>) -> Result<PholdReport, PholdError> {
-    run_on(cfg, end, tw, &ObjectMap::Block)
+    let executor = match tw {
+        None => PholdExecutor::Sequential,
+        Some(c) => PholdExecutor::TimeWarp(c, ObjectMap::Block),
+    };
+    run_with(cfg, end, executor)
 }
 
-/// [`run`] with Time Warp's objects placed on its workers by `map` ([`ObjectMap::Block`] puts
-/// each partition on one worker when the partitions match the workers).
-pub fn run_on(
+/// Runs PHOLD up to time `end` on `executor`.
+pub fn run_with(
     cfg: PholdConfig,
     end: f64,
-    tw: Option<TwConfig>,
-    map: &ObjectMap,
+    executor: PholdExecutor,
 ) -> Result<PholdReport, PholdError> {
     let start = std::time::Instant::now();
     let (objects, events_per_object, remote, partitions) = (
@@ -248,29 +269,37 @@ pub fn run_on(
     let (model, states) = Phold::new(cfg);
     let t0 = VTime::start(0.0);
     let never = |_: &Phold, _: &[PholdState], _: ()| -> Result<(), Infallible> { Ok(()) };
-    let mut ex: Box<dyn Executor<Phold, Infallible>> = match tw {
-        None => Box::new(Sequential::new(model, states, t0)),
-        Some(c) => Box::new(TimeWarp::new(model, states, t0, map, c)),
+    let (mut ex, engine): (Box<dyn Executor<Phold, Infallible>>, _) = match executor {
+        PholdExecutor::Sequential => (Box::new(Sequential::new(model, states, t0)), "objects"),
+        PholdExecutor::TimeWarp(c, map) => (
+            Box::new(TimeWarp::new(model, states, t0, &map, c)),
+            "time-warp",
+        ),
+        PholdExecutor::Conservative(c, map) => (
+            Box::new(Conservative::new(model, states, t0, &map, c)?),
+            "conservative",
+        ),
     };
     ex.run(end, &mut { never })?;
     let (stats, finals, time_warp) = (ex.stats().clone(), ex.states().to_vec(), ex.tw_stats());
+    let conservative = ex.conservative_stats();
     let rounds = ex.round_records().to_vec();
     ex.free();
     let wall = start.elapsed().as_secs_f64();
     let committed = stats.delivered;
     let events_per_second = committed as f64 / wall.max(1e-9);
-    let cores = time_warp.as_ref().map_or(1, |t| t.workers.max(1));
+    let cores = match (&time_warp, &conservative) {
+        (Some(t), _) => t.workers.max(1),
+        (_, Some(c)) => c.workers.max(1) as u64,
+        _ => 1,
+    };
     Ok(PholdReport {
         objects,
         events_per_object,
         remote,
         partitions,
         end,
-        engine: if time_warp.is_some() {
-            "time-warp"
-        } else {
-            "objects"
-        },
+        engine,
         committed,
         wall_seconds: wall,
         events_per_second,
@@ -281,6 +310,7 @@ pub fn run_on(
                 .flat_map(|s| [s.handled, s.sends, s.rng.clone().next_u64()]),
         ),
         time_warp,
+        conservative,
         sequential_wall_seconds: None,
         speedup: None,
         rounds,

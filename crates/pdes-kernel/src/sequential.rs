@@ -14,7 +14,7 @@ pub type Sink<'a, M, E> =
     dyn FnMut(&M, &[<M as Model>::State], <M as Model>::Output) -> Result<(), E> + 'a;
 
 /// A pending message ordered for a min-heap.
-struct Item<T, M>(Pending<T, M>);
+pub(crate) struct Item<T, M>(pub(crate) Pending<T, M>);
 
 impl<T: Time, M> PartialEq for Item<T, M> {
     fn eq(&self, o: &Self) -> bool {

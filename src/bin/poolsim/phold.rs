@@ -1,6 +1,8 @@
 //! `poolsim phold`: PHOLD, the standard PDES benchmark, on the kernel.
 
 use crate::common::*;
+use pdes_kernel::phold::{PholdError, PholdExecutor};
+use pdes_kernel::time_warp::ObjectMap;
 
 /// `poolsim phold --engine`: which executor runs PHOLD.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -9,6 +11,8 @@ pub enum PholdEngine {
     Objects,
     /// Time Warp.
     TimeWarp,
+    /// The conservative executor: windows of the lookahead (needs --lookahead above 0).
+    Conservative,
 }
 
 /// `poolsim phold --map`: how Time Warp places the objects on its workers.
@@ -36,13 +40,14 @@ pub struct PholdArgs {
     /// ranks, or 2 on the sequential kernel).
     #[arg(long)]
     pub partitions: Option<u32>,
-    /// objects (the sequential kernel) or time-warp.
+    /// objects (the sequential kernel), time-warp, or conservative (threads of one process).
     #[arg(long, value_enum, default_value = "objects")]
     pub engine: PholdEngine,
-    /// Time Warp workers per rank (default: this machine's cores).
+    /// Workers of Time Warp (per rank) or of the conservative executor (default: this
+    /// machine's cores).
     #[arg(long)]
     pub workers: Option<usize>,
-    /// Time Warp: how objects are placed on the workers (block keeps each partition on one
+    /// Time Warp and conservative: how objects are placed on the workers (block keeps each partition on one
     /// worker; round-robin spreads them, so most messages cross between workers).
     #[arg(long, value_enum)]
     pub map: Option<PholdMap>,
@@ -73,8 +78,8 @@ pub struct PholdArgs {
     /// batches, rollbacks and remote messages so far.
     #[arg(long)]
     pub stats: Option<std::path::PathBuf>,
-    /// Time Warp: run the same model on the sequential kernel first (rank 0 alone under MPI)
-    /// and report the speed-up over it.
+    /// Time Warp and conservative: run the same model on the sequential kernel first (rank 0
+    /// alone under MPI) and report the speed-up over it.
     #[arg(long)]
     pub baseline: bool,
 }
@@ -110,18 +115,22 @@ fn check_values(a: &PholdArgs) -> Result<(), Failure> {
 
 /// Runs `poolsim phold` and prints its report (on rank 0 under MPI).
 pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
-    use pdes_kernel::phold::run;
-    use pdes_kernel::time_warp::ObjectMap;
+    use pdes_kernel::phold::{run, run_with};
     check_values(a)?;
-    let tw = tw_config(a)?;
-    if tw.is_some() {
+    let executor = executor(a)?;
+    if !matches!(executor, PholdExecutor::Sequential) {
         poolsim::memory::transparent_huge_pages(false);
     }
     #[cfg(feature = "mpi")]
-    let _mpi = if tw.is_some() { start_mpi()? } else { None };
-    let partitions = a.partitions.unwrap_or_else(|| match &tw {
-        Some(c) => pdes_kernel::time_warp::threads::total_workers(c) as u32,
-        None => 2,
+    let _mpi = if matches!(executor, PholdExecutor::TimeWarp(..)) {
+        start_mpi()?
+    } else {
+        None
+    };
+    let partitions = a.partitions.unwrap_or(match &executor {
+        PholdExecutor::Sequential => 2,
+        PholdExecutor::TimeWarp(c, _) => pdes_kernel::time_warp::threads::total_workers(c) as u32,
+        PholdExecutor::Conservative(c, _) => c.workers as u32,
     });
     check_sizes(a, partitions)?;
     let stats = match &a.stats {
@@ -136,12 +145,10 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
     } else {
         None
     };
-    let map = match a.map {
-        Some(PholdMap::RoundRobin) => ObjectMap::RoundRobin,
-        Some(PholdMap::Block) | None => ObjectMap::Block,
-    };
-    let mut report =
-        pdes_kernel::phold::run_on(cfg, a.end, tw, &map).map_err(|e| internal(e.to_string()))?;
+    let mut report = run_with(cfg, a.end, executor).map_err(|e| match e {
+        PholdError::Refused(r) => usage(format!("--engine conservative: {r}")),
+        e => internal(e.to_string()),
+    })?;
     if rank != 0 {
         return Ok(());
     }
@@ -160,30 +167,55 @@ pub fn phold(a: &PholdArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Time Warp's settings from the flags, or `None` for the sequential kernel (which takes no
-/// Time Warp flag).
-fn tw_config(a: &PholdArgs) -> Result<Option<pdes_kernel::time_warp::TwConfig>, Failure> {
-    if a.engine == PholdEngine::TimeWarp {
-        return Ok(Some(pdes_kernel::time_warp::TwConfig {
-            final_batches: !a.tw_pure,
-            burst: burst(a.tw_burst)?,
-            record_rounds: a.stats.is_some(),
-            ..tw_workers(a.workers)?
-        }));
-    }
-    for (flag, given) in [
-        ("--workers", a.workers.is_some()),
-        ("--map", a.map.is_some()),
+/// The executor the flags ask for, with its settings; refuses flags its executor does not take.
+fn executor(a: &PholdArgs) -> Result<PholdExecutor, Failure> {
+    use pdes_kernel::conservative::ConservativeConfig;
+    let map = match a.map {
+        Some(PholdMap::RoundRobin) => ObjectMap::RoundRobin,
+        Some(PholdMap::Block) | None => ObjectMap::Block,
+    };
+    let time_warp_only = [
         ("--tw-pure", a.tw_pure),
         ("--tw-burst", a.tw_burst.is_some()),
         ("--stats", a.stats.is_some()),
+    ];
+    let parallel_only = [
+        ("--workers", a.workers.is_some()),
+        ("--map", a.map.is_some()),
         ("--baseline", a.baseline),
-    ] {
-        if given {
-            return Err(usage(format!("{flag}: only the time-warp engine takes it")));
+    ];
+    let refuse = |flags: &[(&str, bool)], who: &str| match flags.iter().find(|f| f.1) {
+        Some((flag, _)) => Err(usage(format!("{flag}: only {who} takes it"))),
+        None => Ok(()),
+    };
+    match a.engine {
+        PholdEngine::TimeWarp => {
+            let cfg = pdes_kernel::time_warp::TwConfig {
+                final_batches: !a.tw_pure,
+                burst: burst(a.tw_burst)?,
+                record_rounds: a.stats.is_some(),
+                ..tw_workers(a.workers)?
+            };
+            Ok(PholdExecutor::TimeWarp(cfg, map))
+        }
+        PholdEngine::Conservative => {
+            refuse(&time_warp_only, "the time-warp engine")?;
+            let tw = tw_workers(a.workers)?;
+            let cfg = ConservativeConfig {
+                workers: tw.workers,
+                chaos: tw.chaos,
+            };
+            Ok(PholdExecutor::Conservative(cfg, map))
+        }
+        PholdEngine::Objects => {
+            refuse(&time_warp_only, "the time-warp engine")?;
+            refuse(
+                &parallel_only,
+                "a parallel engine (time-warp, conservative)",
+            )?;
+            Ok(PholdExecutor::Sequential)
         }
     }
-    Ok(None)
 }
 
 /// Refuses object, event and partition counts PHOLD cannot run with.
@@ -288,6 +320,17 @@ fn print_report(report: &pdes_kernel::phold::PholdReport, json: bool) {
                 t.efficiency(),
                 t.rollbacks,
                 t.gvt_rounds
+            );
+        }
+        if let Some(c) = &report.conservative {
+            println!(
+                "conservative: {} workers, {} windows of {}, {:.0} batches per window, {} \
+                 messages between workers",
+                c.workers,
+                c.windows,
+                c.lookahead,
+                c.batches.iter().sum::<u64>() as f64 / c.windows.max(1) as f64,
+                c.remote_messages
             );
         }
         if let (Some(x), Some(seq)) = (report.speedup, report.sequential_wall_seconds) {
