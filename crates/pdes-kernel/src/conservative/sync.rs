@@ -37,6 +37,9 @@ impl SpinBarrier {
     /// Waits until every party has arrived. What each party wrote before arriving is seen by
     /// every party after it returns.
     pub fn wait(&self) -> Result<(), Poisoned> {
+        if self.poisoned.load(Ordering::Relaxed) {
+            return Err(Poisoned);
+        }
         let generation = self.generation.load(Ordering::Acquire);
         if self.arrived.fetch_add(1, Ordering::AcqRel) + 1 == self.parties {
             self.arrived.store(0, Ordering::Relaxed);
