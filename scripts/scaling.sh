@@ -44,6 +44,8 @@
 #   --repeats N           runs of each configuration (default 3)
 #   --models LIST         gas, phold or both (default gas,phold)
 #   --mpi                 build with the `mpi` feature and add the MPI rows
+#   --conservative        add PHOLD rows on the conservative executor (`--engine conservative
+#                         --workers W`, the same counts; needs a positive --phold-lookahead)
 #   --cpus LIST           run every measured process on these CPUs only (e.g. 2,3 or 0-7, through
 #                         python3's os.sched_setaffinity); the cores counted are these
 #   --timeout S           limit for one run, seconds (default 600); a run past it counts as failed
@@ -60,9 +62,10 @@
 #   model          gas or phold
 #   size           balls (gas) or objects (phold)
 #   until          the run's end time (--until or --end)
-#   executor       seq (sequential objects engine / kernel), tw (Time Warp on threads), mpi
-#   ranks          MPI ranks (1 for seq and tw)
-#   workers        Time Warp workers per rank (0 for seq)
+#   executor       seq (sequential objects engine / kernel), tw (Time Warp on threads), mpi,
+#                  cons (the conservative executor, PHOLD only)
+#   ranks          MPI ranks (1 for seq, tw and cons)
+#   workers        Time Warp or conservative workers per rank (0 for seq)
 #   cores          ranks x workers (1 for seq)
 #   repeat         1 .. --repeats
 #   slot           the run's place within its repeat (1 = first)
@@ -79,7 +82,7 @@
 #   efficiency     time_warp committed / processed; empty for seq
 #   final_share    time_warp final_batches / committed; empty for seq
 #   remote_fraction time_warp remote_messages / messages; empty for seq
-#   gvt_rounds     time_warp.gvt_rounds; empty for seq
+#   gvt_rounds     time_warp.gvt_rounds (cons: conservative.windows); empty for seq
 #   rollbacks      time_warp.rollbacks; empty for seq
 #   peak_rss_mib   time_warp.peak_rss_mib (gas on Time Warp only); empty otherwise
 #   digest         final_state_digest
@@ -94,7 +97,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd) || die "cannot find the re
 
 balls=99856 until=0.5 phold_objects=16384 phold_end=10 phold_partitions=
 phold_remote=0.1 phold_lookahead=0.1
-workers_list= max_workers= repeats=3 models=gas,phold use_mpi=0 cpus= timeout_s=600
+workers_list= max_workers= repeats=3 models=gas,phold use_mpi=0 use_cons=0 cpus= timeout_s=600
 build=1 binary= out=
 args_given=("$@")
 
@@ -102,7 +105,7 @@ while (($#)); do
   opt=$1 val=
   case $opt in
     --*=*) val=${opt#*=}; opt=${opt%%=*}; shift ;;
-    --mpi|--no-build|-h|--help) shift ;;
+    --mpi|--conservative|--no-build|-h|--help) shift ;;
     --*) (($# >= 2)) || die "$opt: needs a value"; val=$2; shift 2 ;;
     *) die "unknown argument: $opt (see --help)" ;;
   esac
@@ -119,6 +122,7 @@ while (($#)); do
     --repeats) repeats=$val ;;
     --models) models=$val ;;
     --mpi) use_mpi=1 ;;
+    --conservative) use_cons=1 ;;
     --cpus) cpus=$val ;;
     --timeout) timeout_s=$val ;;
     --no-build) build=0 ;;
@@ -309,6 +313,7 @@ elif not isinstance(s, dict):
     status = "no-json"
 s = s if isinstance(s, dict) else {}
 tw = s.get("time_warp") or {}
+cons = s.get("conservative") or {}
 if status == "ok" and executor == "mpi" and tw.get("ranks") != ranks:
     status = f"ranks:{tw.get('ranks')}"
 
@@ -334,12 +339,12 @@ row = [model, size, until, executor, ranks, workers, cores, repeat, slot, status
        "%.6f" % (int(process_us) / 1e6), num(s.get("wall_seconds")), num(setup),
        num(events, "{}"), num(s.get("events_per_second"), "{:.1f}"),
        num(None if batches is None else int(batches), "{}"), num(eff), num(fin), num(remote),
-       num(tw.get("gvt_rounds"), "{}"), num(tw.get("rollbacks"), "{}"),
+       num(tw.get("gvt_rounds", cons.get("windows")), "{}"), num(tw.get("rollbacks"), "{}"),
        num(tw.get("peak_rss_mib"), "{:.1f}"), s.get("final_state_digest", ""),
        json.dumps(s, separators=(",", ":")) if s else ""]
 print("\t".join(map(str, row)))
 what = {"seq": "sequential", "tw": f"{workers} worker{'s' * (workers > 1)}",
-        "mpi": f"{ranks} ranks x {workers}"}[executor]
+        "mpi": f"{ranks} ranks x {workers}", "cons": f"conservative, {workers}"}[executor]
 extra = f" ({open(outfile + '.err', errors='replace').read().strip()[:300]})" if status != "ok" else ""
 print(f"  {model} {what:<18} #{repeat}  {num(s.get('wall_seconds'), '{:8.3f}')} s  "
       f"{s.get('final_state_digest', '')}  {status}{extra}", file=sys.stderr)
@@ -350,6 +355,9 @@ run_one() {
   local model=$1 executor=$2 ranks=$3 workers=$4 repeat=$5 slot=$6 size end
   local -a cmd=() engine=(--engine objects)
   [[ $executor != seq ]] && engine=(--engine time-warp --workers "$workers")
+  [[ $executor == cons ]] && engine=(--engine conservative --workers "$workers")
+  # the pool's relays have no lookahead: the conservative executor runs PHOLD alone
+  [[ $executor == cons && $model == gas ]] && return 0
   if [[ $model == gas ]]; then
     size=$balls end=$until
     cmd=("$bin" run gas --balls "$balls" --until "$until" --sectors auto "${engine[@]}" --json --quiet)
@@ -380,6 +388,9 @@ configs=("seq 1 0")
 for w in "${counts[@]}"; do configs+=("tw 1 $w"); done
 if ((use_mpi)); then
   for r in "${counts[@]}"; do ((r >= 2)) && configs+=("mpi $r 1"); done
+fi
+if ((use_cons)); then
+  for w in "${counts[@]}"; do configs+=("cons 1 $w"); done
 fi
 
 selected=()
@@ -442,7 +453,7 @@ for (model, size, until), rs in models.items():
     confs = defaultdict(list)
     for r in ok:
         confs[(r["executor"], int(r["ranks"]), int(r["workers"]))].append(r)
-    order = {"seq": 0, "tw": 1, "mpi": 2}
+    order = {"seq": 0, "tw": 1, "mpi": 2, "cons": 3}
     seq = confs.get(("seq", 1, 0), [])
     seq_med = statistics.median(float(r["wall_s"]) for r in seq) if seq else None
     seq_by_rep = {r["repeat"]: float(r["wall_s"]) for r in seq}
@@ -459,7 +470,8 @@ for (model, size, until), rs in models.items():
         t = sorted(float(r["wall_s"]) for r in cr)
         med = statistics.median(t)
         name = {"seq": "sequential", "tw": f"Time Warp, {workers} worker{'s' * (workers > 1)}",
-                "mpi": f"MPI, {ranks} ranks x {workers}"}[ex]
+                "mpi": f"MPI, {ranks} ranks x {workers}",
+                "cons": f"conservative, {workers} w."}[ex]
         within = [seq_by_rep[r["repeat"]] / float(r["wall_s"]) for r in cr
                   if r["repeat"] in seq_by_rep and float(r["wall_s"]) > 0]
         speed = f"{seq_med / med:.2f}" if seq_med and med > 0 else ""
