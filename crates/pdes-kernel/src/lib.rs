@@ -1,6 +1,7 @@
 //! A generic message-passing discrete-event kernel: objects that exchange timestamped messages,
-//! run in order by the [`sequential`] executor or optimistically in parallel by [`time_warp`]
-//! (threads; MPI ranks behind the `mpi` feature). [`phold`], the standard benchmark of parallel
+//! run in order by the [`sequential`] executor, optimistically in parallel by [`time_warp`]
+//! (threads; MPI ranks behind the `mpi` feature), or in parallel windows of the model's
+//! lookahead by [`conservative`] (threads). [`phold`], the standard benchmark of parallel
 //! discrete-event simulators, is its benchmark model and example.
 //!
 //! ```text
