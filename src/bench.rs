@@ -154,12 +154,14 @@ pub enum BenchError {
     /// A PHOLD run failed.
     #[error(transparent)]
     Phold(#[from] PholdError),
-    /// PHOLD under Time Warp ended in another state than on the sequential kernel.
+    /// PHOLD on a parallel executor ended in another state than on the sequential kernel.
     #[error(
-        "bench: PHOLD under Time Warp on {workers} workers ended in state {digest}, on the \
+        "bench: PHOLD on {engine} with {workers} workers ended in state {digest}, on the \
          sequential kernel in {sequential}"
     )]
     PholdDigest {
+        /// The executor.
+        engine: &'static str,
         /// The workers (0: none).
         workers: usize,
         /// Its final state digest.
@@ -484,13 +486,16 @@ pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchRepo
     })
 }
 
-/// PHOLD on the sequential kernel, then under Time Warp on each worker count, one model
-/// throughout; fails if a digest differs.
+/// PHOLD on the sequential kernel, then under Time Warp and on the conservative executor on
+/// each worker count, one model throughout; fails if a digest differs.
 fn measure_phold(
     a: &BenchOptions,
     partitions: u32,
     each: &mut dyn FnMut(Measured),
 ) -> Result<Vec<PholdReport>, BenchError> {
+    use pdes_kernel::conservative::ConservativeConfig;
+    use pdes_kernel::phold::PholdExecutor;
+    use pdes_kernel::time_warp::{ObjectMap, TwConfig};
     let phold_cfg = PholdConfig {
         objects: a.phold_objects,
         events_per_object: 16,
@@ -500,20 +505,34 @@ fn measure_phold(
         mean: 1.0,
         seed: 1,
     };
-    let mut phold: Vec<PholdReport> = Vec::new();
-    for workers in std::iter::once(None).chain(a.tw_workers.iter().map(|&w| Some(w))) {
-        let tw = workers.map(|w| pdes_kernel::time_warp::TwConfig {
+    let time_warp = a.tw_workers.iter().map(|&w| {
+        let cfg = TwConfig {
             workers: w,
             final_batches: !a.tw_pure,
             ..Default::default()
-        });
-        let p = pdes_kernel::phold::run(phold_cfg.clone(), 20.0, tw)?;
+        };
+        (w, PholdExecutor::TimeWarp(cfg, ObjectMap::Block))
+    });
+    let conservative = a.tw_workers.iter().map(|&w| {
+        let cfg = ConservativeConfig {
+            workers: w,
+            chaos: None,
+        };
+        (w, PholdExecutor::Conservative(cfg, ObjectMap::Block))
+    });
+    let mut phold: Vec<PholdReport> = Vec::new();
+    for (workers, executor) in std::iter::once((0, PholdExecutor::Sequential))
+        .chain(time_warp)
+        .chain(conservative)
+    {
+        let p = pdes_kernel::phold::run_with(phold_cfg.clone(), 20.0, executor)?;
         if let Some(first) = phold
             .first()
             .filter(|f| f.final_state_digest != p.final_state_digest)
         {
             return Err(BenchError::PholdDigest {
-                workers: workers.unwrap_or(0),
+                engine: p.engine,
+                workers,
                 digest: p.final_state_digest,
                 sequential: first.final_state_digest.clone(),
             });

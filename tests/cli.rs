@@ -648,12 +648,31 @@ fn bench_json_has_the_machine_and_one_row() {
     assert_eq!(u(&rows[0]["balls"]), 100);
     assert_eq!(f(&rows[0]["area_fraction"]), 0.3);
     assert!(u(&rows[0]["events"]) >= 20_000, "{}", rows[0]);
-    // PHOLD on the sequential kernel, then on 1 and 2 workers, each set beside ROSS's record
+    // PHOLD on the sequential kernel, then on 1 and 2 workers of Time Warp and of the
+    // conservative executor, each set beside ROSS's record
     let ross = f(&v["phold_ross_events_per_second_per_core"]);
     assert!((ross - 504e9 / 1_966_080.0).abs() < 1.0, "{ross}");
     let phold = v["phold"].as_array().expect("a phold array");
-    assert_eq!(phold.len(), 3, "{v}");
-    for (p, cores) in phold.iter().zip([1.0, 1.0, 2.0]) {
+    assert_eq!(phold.len(), 5, "{v}");
+    let engines: Vec<&str> = phold
+        .iter()
+        .map(|p| p["engine"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        engines,
+        [
+            "objects",
+            "time-warp",
+            "time-warp",
+            "conservative",
+            "conservative"
+        ]
+    );
+    for (p, cores) in phold.iter().zip([1.0, 1.0, 2.0, 1.0, 2.0]) {
+        assert_eq!(
+            p["final_state_digest"], phold[0]["final_state_digest"],
+            "{p}"
+        );
         assert!(u(&p["committed"]) > 0, "{p}");
         assert_eq!(p["committed"], phold[0]["committed"], "{p}");
         let (all, per_core) = (

@@ -283,9 +283,14 @@ fn time_warp_row(r: &TwRow) {
 }
 
 fn phold_row(p: &PholdReport) {
-    let executor = match &p.time_warp {
-        Some(t) if t.workers == 1 => "1 worker".to_string(),
-        Some(t) => format!("{} workers", t.workers),
+    let workers = match (&p.time_warp, &p.conservative) {
+        (Some(t), _) => Some(t.workers as usize),
+        (_, Some(c)) => Some(c.workers),
+        _ => None,
+    };
+    let executor = match workers {
+        Some(1) => "1 worker".to_string(),
+        Some(w) => format!("{w} workers"),
         None => "sequential kernel".to_string(),
     };
     println!(
