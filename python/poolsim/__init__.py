@@ -1,0 +1,354 @@
+"""poolsim: exact, event-driven simulation of pool balls and hard disks, with numpy arrays.
+
+The package runs the poolsim library (Rust) in the calling process, with Python's lock
+released while an engine runs, and returns its results as numpy arrays::
+
+    import poolsim
+    r = poolsim.run("gas", until=4)
+    r["final_state_digest"]          # the command line's summary, as a dict
+    r.events                         # structured array: t, kind, a, b
+    r.final.position                 # (N, 2) array of the balls at the end
+
+Scenarios are the command line's: a built-in name (``poolsim.builtins()``), the path of a TOML
+file, TOML text, or a :class:`Scenario` made from arrays. Bad input raises ``ValueError`` with
+the command line's one-line message.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterator, Sequence
+
+import numpy as np
+
+from . import _native
+
+__all__ = [
+    "EVENT_DTYPE",
+    "EVENT_KINDS",
+    "EventStream",
+    "Result",
+    "Scenario",
+    "State",
+    "builtins",
+    "phold",
+    "run",
+    "stream",
+]
+
+#: Names of the event kinds, indexed by the ``kind`` field of an event array.
+EVENT_KINDS: tuple[str, ...] = tuple(_native.event_kinds())
+
+#: The dtype of an event array: time, kind (an index into :data:`EVENT_KINDS`), the ball, and
+#: the other object's index within its kind (a ball, cushion, pocket or corner, from 0).
+EVENT_DTYPE = np.dtype([("t", "<f8"), ("kind", "u1"), ("a", "<u4"), ("b", "<u4")])
+
+
+@dataclass(frozen=True)
+class State:
+    """Every ball at one time.
+
+    ``position`` and ``velocity`` are ``(N, 2)`` float arrays; ``radius`` and ``mass`` have one
+    entry per ball; ``pocket`` is the pocket (from 0) a ball dropped into, -1 for a ball still
+    on the table (whose position is where its centre crossed the pocket line).
+    """
+
+    t: float
+    position: np.ndarray
+    velocity: np.ndarray
+    radius: np.ndarray
+    mass: np.ndarray
+    pocket: np.ndarray
+
+    @classmethod
+    def _of(cls, d: dict[str, Any]) -> State:
+        return cls(d["t"], d["position"], d["velocity"], d["radius"], d["mass"], d["pocket"])
+
+
+def _events(columns: dict[str, np.ndarray] | None) -> np.ndarray | None:
+    if columns is None:
+        return None
+    out = np.empty(len(columns["t"]), dtype=EVENT_DTYPE)
+    for name in EVENT_DTYPE.names:
+        out[name] = columns[name]
+    return out
+
+
+@dataclass(frozen=True)
+class Result:
+    """What a run produced.
+
+    ``summary`` is the command line's ``--json`` summary (a dict); ``result[key]`` reads it.
+    ``events`` is a structured array of :data:`EVENT_DTYPE` in the order the events happened
+    (``None`` when the run was asked for none), ``final`` the balls at the end, ``samples`` the
+    balls at each multiple of ``sample_every``.
+    """
+
+    summary: dict[str, Any]
+    events: np.ndarray | None
+    final: State
+    samples: list[State]
+
+    def __getitem__(self, key: str) -> Any:
+        return self.summary[key]
+
+    @property
+    def digest(self) -> str:
+        """The final state's digest: equal digests, bit-identical final states."""
+        return self.summary["final_state_digest"]
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A scenario as TOML text (the format of ``docs/formats.md``), to run with :func:`run`."""
+
+    toml: str
+    name: str = "scenario"
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> Scenario:
+        """The scenario in a TOML file (read now; errors name the file when it runs)."""
+        p = Path(path)
+        return cls(p.read_text(), str(p))
+
+    @classmethod
+    def box(
+        cls,
+        width: float,
+        height: float,
+        positions: Sequence[Sequence[float]] | np.ndarray,
+        velocities: Sequence[Sequence[float]] | np.ndarray,
+        radius: float | Sequence[float] | np.ndarray = 1.0,
+        mass: float | Sequence[float] | np.ndarray = 1.0,
+        until: float = 10.0,
+    ) -> Scenario:
+        """Balls in a ``width`` x ``height`` box of elastic cushions with its corner at the origin.
+
+        ``positions`` and ``velocities`` are ``(N, 2)``; ``radius`` and ``mass`` a number or one
+        per ball. Every number is written so that it reads back to the same bits.
+        """
+        pos = np.asarray(positions, dtype=float)
+        vel = np.asarray(velocities, dtype=float)
+        if pos.ndim != 2 or pos.shape[1] != 2 or vel.shape != pos.shape:
+            raise ValueError(
+                f"positions, velocities: must both be (N, 2), got {pos.shape} and {vel.shape}"
+            )
+        n = len(pos)
+        rad = np.broadcast_to(np.asarray(radius, dtype=float), (n,))
+        mas = np.broadcast_to(np.asarray(mass, dtype=float), (n,))
+        num = _toml_float
+        lines = ["[run]", f"until = {num(until)}", ""]
+        for k in range(n):
+            lines += [
+                "[[ball]]",
+                f"position = [{num(pos[k, 0])}, {num(pos[k, 1])}]",
+                f"velocity = [{num(vel[k, 0])}, {num(vel[k, 1])}]",
+                f"radius = {num(rad[k])}",
+                f"mass = {num(mas[k])}",
+            ]
+        w, h = num(width), num(height)
+        for a, b in [("0.0, 0.0", f"0.0, {h}"), (f"0.0, {h}", f"{w}, {h}"),
+                     (f"{w}, {h}", f"{w}, 0.0"), (f"{w}, 0.0", "0.0, 0.0")]:
+            lines += ["[[cushion]]", f"from = [{a}]", f"to = [{b}]"]
+        return cls("\n".join(lines) + "\n", "box")
+
+
+def _toml_float(x: float) -> str:
+    x = float(x)
+    if not math.isfinite(x):
+        raise ValueError(f"not a finite number: {x}")
+    return repr(x)
+
+
+def _whole(name: str, value: Any, least: int) -> None:
+    """Refuses a value that is not a whole number of at least ``least`` (``None`` passes)."""
+    if value is None:
+        return
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+        raise ValueError(f"{name}: must be a whole number of at least {least}, got {value!r}")
+
+
+def builtins() -> dict[str, str]:
+    """The built-in scenarios: name to description."""
+    return dict(_native.builtins())
+
+
+def _ask(
+    scenario: str | Path | Scenario,
+    until: float | None,
+    engine: str,
+    dt: float | None,
+    workers: int | None,
+    sectors: str | tuple[int, int] | None,
+    check: bool,
+    sample_every: float | None,
+    events: bool,
+    params: dict[str, Any],
+) -> tuple[str, dict[str, Any]]:
+    for name, value, least in [("balls", params.get("balls"), 1), ("seed", params.get("seed"), 0),
+                               ("workers", workers, 1)]:
+        _whole(name, value, least)
+    if isinstance(scenario, Scenario):
+        spec, text = scenario.name, scenario.toml
+    else:
+        spec, text = str(scenario), None
+    if sectors not in (None, "auto") and not (
+        isinstance(sectors, tuple) and len(sectors) == 2
+    ):
+        raise ValueError(f"sectors: None, 'auto' or (nx, ny), got {sectors!r}")
+    ask = {
+        "toml": text,
+        "until": until,
+        "engine": engine,
+        "dt": dt,
+        "workers": workers,
+        "sectors": sectors if isinstance(sectors, tuple) else None,
+        "auto_sectors": sectors == "auto",
+        "check": check,
+        "sample_every": sample_every,
+        "events": events,
+        "balls": params.get("balls"),
+        "seed": params.get("seed"),
+        "area_fraction": params.get("area_fraction"),
+        "radius": params.get("radius"),
+        "speed_max": params.get("speed_max"),
+    }
+    return spec, ask
+
+
+def run(
+    scenario: str | Path | Scenario = "gas",
+    *,
+    until: float | None = None,
+    engine: str = "event-list",
+    dt: float | None = None,
+    workers: int | None = None,
+    sectors: str | tuple[int, int] | None = None,
+    check: bool = False,
+    sample_every: float | None = None,
+    events: bool = True,
+    balls: int | None = None,
+    seed: int | None = None,
+    area_fraction: float | None = None,
+    radius: float | None = None,
+    speed_max: float | None = None,
+) -> Result:
+    """Runs a scenario to ``until`` (default: the scenario's own end) and returns its results.
+
+    ``engine`` is ``"event-list"`` (the reference), ``"time-step"`` (needs ``dt``),
+    ``"objects"`` or ``"time-warp"`` (``workers`` threads); ``sectors`` (``"auto"`` or
+    ``(nx, ny)``) runs the objects on a sectored table. ``check`` checks invariants at every
+    event. ``balls``, ``seed``, ``area_fraction``, ``radius`` and ``speed_max`` are the
+    built-in generators' parameters. The engine runs with Python's lock released, so threads
+    can run simulations side by side.
+    """
+    spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, sample_every, events,
+                     dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
+                          speed_max=speed_max))
+    d = _native.run(spec, ask)
+    return Result(
+        summary=json.loads(d["summary"]),
+        events=_events(d["events"]),
+        final=State._of(d["final"]),
+        samples=[State._of(s) for s in d["samples"]],
+    )
+
+
+class EventStream:
+    """A run's events in chunks (structured arrays of :data:`EVENT_DTYPE`), as it goes.
+
+    At most two chunks wait at any time, so memory stays bounded however long the run. After
+    the last chunk, ``summary`` holds the run summary. ``close()`` (or leaving a ``with``
+    block) stops a run that still goes on.
+    """
+
+    def __init__(self, native: Any) -> None:
+        self._native = native
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        for columns in self._native:
+            yield _events(columns)
+
+    @property
+    def summary(self) -> dict[str, Any] | None:
+        """The run summary, once every chunk has been read."""
+        s = self._native.summary
+        return None if s is None else json.loads(s)
+
+    def close(self) -> None:
+        """Stops the run and waits for it."""
+        self._native.close()
+
+    def __enter__(self) -> EventStream:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def stream(
+    scenario: str | Path | Scenario = "gas",
+    *,
+    chunk: int = 65536,
+    until: float | None = None,
+    engine: str = "event-list",
+    dt: float | None = None,
+    workers: int | None = None,
+    sectors: str | tuple[int, int] | None = None,
+    check: bool = False,
+    balls: int | None = None,
+    seed: int | None = None,
+    area_fraction: float | None = None,
+    radius: float | None = None,
+    speed_max: float | None = None,
+) -> EventStream:
+    """Starts a run in the background and returns its events in chunks of at most ``chunk``.
+
+    Takes :func:`run`'s arguments (but samples); bad input raises ``ValueError`` here, an error
+    of the run itself when the chunk it stopped at is read.
+    """
+    spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, None, True,
+                     dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
+                          speed_max=speed_max))
+    return EventStream(_native.stream(spec, ask, chunk))
+
+
+def phold(
+    *,
+    objects: int = 1024,
+    events_per_object: int = 16,
+    remote: float = 0.1,
+    lookahead: float = 0.1,
+    mean: float = 1.0,
+    seed: int = 1,
+    end: float = 100.0,
+    engine: str = "objects",
+    workers: int | None = None,
+    partitions: int | None = None,
+) -> dict[str, Any]:
+    """Runs PHOLD, the standard benchmark of parallel discrete-event simulators, on the
+    sequential kernel (``"objects"``), Time Warp (``"time-warp"``) or the conservative
+    executor (``"conservative"``, needs ``lookahead > 0``); returns ``poolsim phold --json``'s
+    report as a dict. ``partitions`` defaults to the workers (2 on the sequential kernel).
+    """
+    for name, value, least in [("objects", objects, 1), ("events_per_object", events_per_object, 1),
+                               ("seed", seed, 0), ("workers", workers, 1),
+                               ("partitions", partitions, 1)]:
+        _whole(name, value, least)
+    return json.loads(
+        _native.phold(
+            objects=objects,
+            events_per_object=events_per_object,
+            remote=remote,
+            lookahead=lookahead,
+            mean=mean,
+            seed=seed,
+            end=end,
+            engine=engine,
+            workers=workers,
+            partitions=partitions,
+        )
+    )

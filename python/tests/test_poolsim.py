@@ -1,0 +1,181 @@
+"""The Python package against the command line: same digests, arrays of the right shapes and
+types, errors as ValueError, streams in bounded memory, threads side by side."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import poolsim
+
+ROOT = Path(__file__).resolve().parents[2]
+BINARY = Path(os.environ.get("POOLSIM_BIN", ROOT / "target" / "release" / "poolsim"))
+
+
+def cli_json(*args: str) -> dict:
+    """The command line's --json output (the binary built by `cargo build --release`)."""
+    assert BINARY.exists(), f"build the command first (cargo build --release): {BINARY}"
+    out = subprocess.run([str(BINARY), *args, "--json"], check=True, capture_output=True, text=True)
+    return json.loads(out.stdout)
+
+
+def test_the_readme_line_gives_the_command_lines_digest():
+    r = poolsim.run("gas", until=4)
+    assert r["final_state_digest"] == cli_json("run", "gas", "--until", "4")["final_state_digest"]
+    assert r.digest == r["final_state_digest"]
+
+
+@pytest.mark.parametrize(
+    "engine, extra",
+    [
+        ("event-list", {}),
+        ("objects", {}),
+        ("objects", {"sectors": "auto"}),
+        ("objects", {"sectors": (2, 3)}),
+        ("time-warp", {"workers": 2}),
+        ("time-warp", {"workers": 3, "sectors": "auto"}),
+    ],
+)
+def test_every_engine_ends_in_the_event_lists_state(engine, extra):
+    reference = poolsim.run("gas", balls=100, seed=3, until=3)
+    r = poolsim.run("gas", balls=100, seed=3, until=3, engine=engine, **extra)
+    assert r.digest == reference.digest
+    assert np.array_equal(r.events, reference.events)
+
+
+def test_events_are_a_structured_array_in_time_order():
+    r = poolsim.run("gas", balls=400, until=5)
+    ev = r.events
+    assert ev.dtype == poolsim.EVENT_DTYPE
+    assert len(ev) == r["events"]["total"] > 1000
+    assert np.all(np.diff(ev["t"]) >= 0)
+    for k, name in enumerate(poolsim.EVENT_KINDS):
+        assert np.count_nonzero(ev["kind"] == k) == r["events"][name]
+    bb = ev[ev["kind"] == poolsim.EVENT_KINDS.index("ball-ball")]
+    assert np.all(bb["a"] < bb["b"]) and np.all(bb["b"] < 400)
+    cushions = ev[ev["kind"] == poolsim.EVENT_KINDS.index("ball-cushion")]
+    assert np.all(cushions["b"] < 4)
+
+
+def test_final_state_and_samples_have_their_shapes_and_times():
+    r = poolsim.run("gas", balls=64, until=2, sample_every=0.5)
+    f = r.final
+    assert f.t == 2.0
+    assert f.position.shape == (64, 2) and f.position.dtype == np.float64
+    assert f.velocity.shape == (64, 2)
+    assert f.radius.shape == (64,) and f.mass.shape == (64,)
+    assert np.all(f.pocket == -1)
+    assert [s.t for s in r.samples] == [0.0, 0.5, 1.0, 1.5, 2.0]
+    assert np.array_equal(r.samples[-1].position, f.position)
+    # kinetic energy is kept (elastic collisions)
+    e = [float(np.sum(s.mass * np.sum(s.velocity**2, axis=1))) for s in r.samples]
+    assert max(e) - min(e) <= 1e-9 * e[0]
+    fixed = cli_json("run", "gas", "--balls", "64", "--until", "2")
+    assert r.digest == fixed["final_state_digest"]
+
+
+def test_a_scenario_from_arrays_runs_as_its_physics_says():
+    sc = poolsim.Scenario.box(
+        100.0, 100.0, [[20.0, 50.0], [60.0, 50.0]], [[1.0, 0.0], [-1.0, 0.0]], radius=5.0, until=20
+    )
+    r = poolsim.run(sc)
+    first = r.events[0]
+    assert poolsim.EVENT_KINDS[first["kind"]] == "ball-ball"
+    assert first["t"] == 15.0
+    # head on, equal masses: the velocities swap
+    assert np.array_equal(r.final.velocity, np.array([[-1.0, 0.0], [1.0, 0.0]]))
+    with pytest.raises(ValueError, match="positions, velocities"):
+        poolsim.Scenario.box(10, 10, [[1, 2, 3]], [[1, 2, 3]])
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: poolsim.run("no-such-scenario"), "not a built-in scenario"),
+        (lambda: poolsim.run("gas", balls=-3), "balls: must be a whole number"),
+        (lambda: poolsim.run("gas", until=-1.0), "until: must be a finite number"),
+        (lambda: poolsim.run("gas", engine="warp"), "engine: one of"),
+        (lambda: poolsim.run("gas", engine="time-step"), "dt: the time-step engine needs"),
+        (lambda: poolsim.run("gas", workers=2), "workers: the event-list engine does not"),
+        (lambda: poolsim.run(poolsim.Scenario("[[ball]]\nposition = [1.0]\n", "bad.toml")),
+         "bad.toml:2"),
+        (lambda: poolsim.phold(engine="conservative", lookahead=0.0), "positive lookahead"),
+        (lambda: poolsim.phold(remote=2.0), "remote: must lie in"),
+    ],
+)
+def test_bad_input_raises_value_error_with_one_line(call, message):
+    with pytest.raises(ValueError, match=message) as e:
+        call()
+    assert "\n" not in str(e.value)
+
+
+def test_a_stream_gives_the_runs_events_in_chunks():
+    whole = poolsim.run("gas", balls=400, until=5)
+    s = poolsim.stream("gas", balls=400, until=5, chunk=1000)
+    chunks = list(s)
+    assert all(0 < len(c) <= 1000 for c in chunks)
+    assert np.array_equal(np.concatenate(chunks), whole.events)
+    assert s.summary["final_state_digest"] == whole.digest
+
+
+def test_a_stream_closed_early_stops_its_run():
+    with poolsim.stream("gas", balls=2000, until=1e6, chunk=500) as s:
+        first = next(iter(s))
+        assert len(first) == 500
+    assert s.summary is None
+
+
+def test_a_long_stream_stays_in_bounded_memory():
+    # a fresh interpreter, so that its peak is this stream's: 2.4 M events would take 41 MB as
+    # arrays; chunks of 10,000 keep at most three
+    script = """
+import resource, poolsim
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+n = sum(len(c) for c in poolsim.stream("gas", balls=10000, until=320, chunk=10000))
+after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(n, (after - before) / 1024)
+"""
+    out = subprocess.run([sys.executable, "-c", script], check=True, capture_output=True, text=True)
+    events, grown_mib = out.stdout.split()
+    assert int(events) > 2_000_000
+    assert float(grown_mib) < 40, f"{grown_mib} MiB grown over {events} events"
+
+
+def test_threads_run_side_by_side_with_the_same_answers():
+    seeds = [1, 2, 3, 4]
+    alone = {s: poolsim.run("gas", balls=900, seed=s, until=4).digest for s in seeds}
+    got: dict[int, str] = {}
+
+    def one(seed: int) -> None:
+        got[seed] = poolsim.run("gas", balls=900, seed=seed, until=4).digest
+
+    threads = [threading.Thread(target=one, args=(s,)) for s in seeds]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert got == alone
+
+
+def test_phold_on_every_executor_gives_the_sequential_digest():
+    seq = poolsim.phold(objects=256, end=10, partitions=2)
+    assert seq["engine"] == "objects" and seq["committed"] > 0
+    for engine in ["time-warp", "conservative"]:
+        r = poolsim.phold(objects=256, end=10, partitions=2, engine=engine, workers=2)
+        assert r["engine"] == engine
+        assert r["final_state_digest"] == seq["final_state_digest"]
+    cli = cli_json("phold", "--objects", "256", "--end", "10", "--partitions", "2")
+    assert cli["final_state_digest"] == seq["final_state_digest"]
+
+
+def test_builtins_are_listed_with_descriptions():
+    b = poolsim.builtins()
+    assert {"gas", "plate1", "implosion"} <= set(b)
+    assert all(isinstance(v, str) and v for v in b.values())
