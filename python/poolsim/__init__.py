@@ -28,6 +28,8 @@ from . import _native
 
 __all__ = [
     "EVENT_DTYPE",
+    "Sample",
+    "Table",
     "EVENT_KINDS",
     "EventStream",
     "Result",
@@ -37,6 +39,9 @@ __all__ = [
     "phold",
     "run",
     "stream",
+    "read_xyz",
+    "to_gsd",
+    "write_xyz",
 ]
 
 #: Names of the event kinds, indexed by the ``kind`` field of an event array.
@@ -68,6 +73,36 @@ class State:
         return cls(d["t"], d["position"], d["velocity"], d["radius"], d["mass"], d["pocket"])
 
 
+@dataclass(frozen=True)
+class Table:
+    """A table's geometry: ``cushions`` and ``pockets`` as ``(M, 2, 2)`` arrays of segment ends,
+    and the corners ``lo`` and ``hi`` of its bounding box."""
+
+    cushions: np.ndarray
+    pockets: np.ndarray
+    lo: tuple[float, float]
+    hi: tuple[float, float]
+
+    @classmethod
+    def _of(cls, d: dict[str, Any]) -> Table:
+        return cls(d["cushions"].reshape(-1, 2, 2), d["pockets"].reshape(-1, 2, 2), d["lo"], d["hi"])
+
+
+@dataclass(frozen=True)
+class Sample:
+    """One frame read from extended XYZ: the balls on the table (``id`` is each one's number,
+    ``Ball-id``), the lattice's ``origin`` and ``size``."""
+
+    t: float
+    origin: tuple[float, float]
+    size: tuple[float, float]
+    id: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+    radius: np.ndarray
+    mass: np.ndarray
+
+
 def _events(columns: dict[str, np.ndarray] | None) -> np.ndarray | None:
     if columns is None:
         return None
@@ -84,13 +119,14 @@ class Result:
     ``summary`` is the command line's ``--json`` summary (a dict); ``result[key]`` reads it.
     ``events`` is a structured array of :data:`EVENT_DTYPE` in the order the events happened
     (``None`` when the run was asked for none), ``final`` the balls at the end, ``samples`` the
-    balls at each multiple of ``sample_every``.
+    balls at each multiple of ``sample_every``, ``table`` the table they ran on.
     """
 
     summary: dict[str, Any]
     events: np.ndarray | None
     final: State
     samples: list[State]
+    table: Table
 
     def __getitem__(self, key: str) -> Any:
         return self.summary[key]
@@ -254,6 +290,7 @@ def run(
         events=_events(d["events"]),
         final=State._of(d["final"]),
         samples=[State._of(s) for s in d["samples"]],
+        table=Table._of(d["table"]),
     )
 
 
@@ -352,3 +389,58 @@ def phold(
             partitions=partitions,
         )
     )
+
+
+def _frames(states: State | Sequence[State]) -> list[State]:
+    return [states] if isinstance(states, State) else list(states)
+
+
+def write_xyz(path: str | Path, states: State | Sequence[State], table: Table) -> None:
+    """Writes states as extended XYZ, the command line's ``--samples`` format (OVITO and ASE read
+    it): one frame per state, the balls on the table, the lattice the table's bounding box."""
+    frames = [
+        (float(s.t), np.ascontiguousarray(s.position, dtype=float),
+         np.ascontiguousarray(s.velocity, dtype=float), np.ascontiguousarray(s.radius, dtype=float),
+         np.ascontiguousarray(s.mass, dtype=float), np.ascontiguousarray(s.pocket, dtype=np.int32))
+        for s in _frames(states)
+    ]
+    _native.write_xyz(str(path), frames, tuple(map(float, table.lo)), tuple(map(float, table.hi)))
+
+
+def read_xyz(path: str | Path) -> list[Sample]:
+    """Every frame of an extended XYZ file written by poolsim (or in its columns)."""
+    return [Sample(**d) for d in _native.read_xyz(str(path))]
+
+
+def to_gsd(path: str | Path, states: State | Sequence[State], table: Table) -> None:
+    """Writes states as a GSD trajectory (HOOMD's format; needs the ``gsd`` package): one frame
+    per state, 2D, the box the table's bounding box with positions relative to its centre,
+    ``diameter`` twice the radius, the time in the log as ``poolsim/t``. GSD stores positions
+    and velocities in single precision."""
+    try:
+        import gsd.hoomd
+    except ImportError as e:
+        raise ImportError("to_gsd needs the gsd package: python3 -m pip install gsd") from e
+    lo, hi = np.asarray(table.lo, dtype=float), np.asarray(table.hi, dtype=float)
+    centre, size = (lo + hi) / 2, hi - lo
+    with gsd.hoomd.open(name=str(path), mode="w") as f:
+        for step, s in enumerate(_frames(states)):
+            on = np.asarray(s.pocket) < 0
+            n = int(np.count_nonzero(on))
+            frame = gsd.hoomd.Frame()
+            frame.configuration.step = step
+            frame.configuration.dimensions = 2
+            frame.configuration.box = [size[0], size[1], 0.0, 0.0, 0.0, 0.0]
+            frame.particles.N = n
+            frame.particles.types = ["X"]
+            frame.particles.typeid = np.zeros(n, dtype=np.uint32)
+            pos = np.zeros((n, 3), dtype=np.float32)
+            pos[:, :2] = s.position[on] - centre
+            vel = np.zeros((n, 3), dtype=np.float32)
+            vel[:, :2] = s.velocity[on]
+            frame.particles.position = pos
+            frame.particles.velocity = vel
+            frame.particles.diameter = (2 * s.radius[on]).astype(np.float32)
+            frame.particles.mass = s.mass[on].astype(np.float32)
+            frame.log["poolsim/t"] = np.array([s.t], dtype=np.float64)
+            f.append(frame)

@@ -134,6 +134,7 @@ impl Collected {
             samples.append(s.into_dict(py)?)?;
         }
         d.set_item("samples", samples)?;
+        d.set_item("table", crate::interop::table_dict(py, &self.table)?)?;
         if let Some(last) = self.last {
             d.set_item("final", last.into_dict(py)?)?;
         }

@@ -4,6 +4,7 @@
 //! documented API; this module's signatures are its contract with them.
 
 mod collect;
+mod interop;
 mod stream;
 
 use collect::{Collected, Columns};
@@ -333,5 +334,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(phold, m)?)?;
     m.add_function(wrap_pyfunction!(stream::stream, m)?)?;
     m.add_class::<stream::Stream>()?;
+    m.add_function(wrap_pyfunction!(interop::write_xyz, m)?)?;
+    m.add_function(wrap_pyfunction!(interop::read_xyz, m)?)?;
     Ok(())
 }

@@ -179,3 +179,62 @@ def test_builtins_are_listed_with_descriptions():
     b = poolsim.builtins()
     assert {"gas", "plate1", "implosion"} <= set(b)
     assert all(isinstance(v, str) and v for v in b.values())
+
+
+def test_samples_written_from_python_are_the_command_lines_byte_for_byte(tmp_path):
+    r = poolsim.run("pool", sample_every=0.5)
+    mine = tmp_path / "mine.xyz"
+    poolsim.write_xyz(mine, r.samples, r.table)
+    theirs = tmp_path / "theirs.xyz"
+    subprocess.run(
+        [str(BINARY), "run", "pool", "--samples", str(theirs), "--sample-every", "0.5", "--quiet"],
+        check=True,
+    )
+    assert mine.read_bytes() == theirs.read_bytes()
+    back = poolsim.read_xyz(mine)
+    assert [s.t for s in back] == [s.t for s in r.samples]
+    last, on = back[-1], r.final.pocket < 0
+    assert np.array_equal(last.id, np.flatnonzero(on) + 1)
+    assert np.array_equal(last.position, r.final.position[on])
+    assert np.array_equal(last.velocity, r.final.velocity[on])
+    assert last.origin == r.table.lo
+
+
+def test_a_bad_xyz_file_names_its_line(tmp_path):
+    bad = tmp_path / "bad.xyz"
+    bad.write_text("2\nTime=0.0\nX 1 2\n")
+    with pytest.raises(ValueError, match="bad.xyz:"):
+        poolsim.read_xyz(bad)
+
+
+def test_gsd_holds_the_states_in_single_precision(tmp_path):
+    import gsd.hoomd as gsd_hoomd
+
+    r = poolsim.run("gas", balls=64, until=2, sample_every=1.0)
+    path = tmp_path / "run.gsd"
+    poolsim.to_gsd(path, r.samples, r.table)
+    centre = (np.asarray(r.table.lo) + np.asarray(r.table.hi)) / 2
+    with gsd_hoomd.open(str(path)) as f:
+        assert len(f) == 3
+        for frame, s in zip(f, r.samples):
+            assert frame.configuration.dimensions == 2
+            assert frame.log["poolsim/t"][0] == s.t
+            got = frame.particles.position[:, :2].astype(float) + centre
+            assert np.allclose(got, s.position, rtol=0, atol=1e-4 * np.abs(s.position).max())
+            assert np.allclose(frame.particles.diameter, 2 * s.radius)
+
+
+def test_a_state_is_drawn_with_its_table_and_balls():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from poolsim.plot import draw
+
+    r = poolsim.run("pool")
+    ax = draw(r.final, r.table, sectors=(2, 2), numbers=True)
+    lines, pockets, discs = ax.collections
+    assert len(lines.get_segments()) == len(r.table.cushions) == 6
+    assert len(pockets.get_segments()) == len(r.table.pockets) == 6
+    on_table = int(np.count_nonzero(r.final.pocket < 0))
+    assert len(discs.get_paths()) == on_table
+    assert len(ax.texts) == on_table
