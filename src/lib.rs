@@ -10,6 +10,7 @@
 //! - [`engine`]: the event-list, time-step and objects engines;
 //! - [`check`]: invariants checked while a run goes (`--check`);
 //! - [`output`]: the trace and the final state; [`summary`]: the run summary;
+//! - [`observe`]: pressure, compressibility factor, temperature and collision rate, in blocks;
 //! - [`memory`]: the one memory setting that depends on the engine (huge pages).
 
 pub mod analytic;
@@ -22,6 +23,7 @@ pub mod experiment;
 pub mod geometry;
 pub mod memory;
 pub mod model;
+pub mod observe;
 pub mod output;
 pub mod physics;
 pub mod polygon;

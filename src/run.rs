@@ -382,6 +382,7 @@ pub fn execute(
             .as_ref()
             .and_then(Interrupt::cause)
             .map(|cause| Interruption::new(outcome.t, cause)),
+        observables: None,
     };
     Ok(Report {
         outcome,

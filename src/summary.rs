@@ -42,6 +42,9 @@ pub struct RunSummary {
     /// Where and why the run stopped before `until`, when it was interrupted.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interrupted: Option<Interruption>,
+    /// Pressure, compressibility factor, temperature and collision rate, when observed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub observables: Option<crate::observe::Observed>,
 }
 
 /// An interrupted run: the time it stopped at, every event up to it done, and the cause.
@@ -280,6 +283,7 @@ mod tests {
             engine_stats: BTreeMap::new(),
             time_warp: None,
             interrupted: None,
+            observables: None,
         };
         let text = serde_json::to_string(&s).unwrap();
         assert!(

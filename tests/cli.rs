@@ -1146,3 +1146,53 @@ fn a_run_starts_from_its_last_sample_as_from_its_final_state() {
         "{line}"
     );
 }
+
+#[test]
+fn run_observes_the_pressure_in_blocks_on_every_engine() {
+    let base = [
+        "run",
+        "gas",
+        "--balls",
+        "100",
+        "--until",
+        "6",
+        "--observe-every",
+        "2",
+        "--json",
+    ];
+    let v = success_json(&base);
+    let o = &v["observables"];
+    assert_eq!(u(&o["blocks"]), 3, "{o}");
+    assert_eq!(f(&o["from"]), 0.0);
+    assert!(f(&o["z"]["mean"]) > 1.0 && f(&o["z"]["error"]) > 0.0, "{o}");
+    assert!(f(&o["pressure_walls"]["mean"]) > 0.0, "{o}");
+    // the same events and balls, so the same figures to the bit
+    for engine in [
+        &["--engine", "objects"][..],
+        &[
+            "--engine",
+            "time-warp",
+            "--workers",
+            "2",
+            "--sectors",
+            "auto",
+        ][..],
+    ] {
+        let other = success_json(&[&base[..], engine].concat());
+        assert_eq!(other["observables"], *o, "{engine:?}");
+    }
+    let plain = success_json(
+        &base[..base.len() - 3]
+            .iter()
+            .chain(&["--json"])
+            .copied()
+            .collect::<Vec<_>>(),
+    );
+    assert!(plain.get("observables").is_none(), "{plain}");
+    assert!(bad_usage(&["run", "gas", "--observe-every", "0"])
+        .contains("--observe-every: must be a positive number"));
+    assert!(bad_usage(&["run", "gas", "--observe-from", "1"])
+        .contains("--observe-from: needs --observe-every"));
+    assert!(bad_usage(&["run", "gas", "--observe-every", "10"])
+        .contains("--observe-from: the first block, from 0 to 10, must lie within the run"));
+}

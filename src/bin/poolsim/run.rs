@@ -97,6 +97,15 @@ pub struct RunArgs {
     /// a power of 10).
     #[arg(long = "sample-every", allow_negative_numbers = true)]
     pub sample_every: Option<f64>,
+    /// Observe the pressure (collision virial and cushions), the compressibility factor, the
+    /// temperature and the collision rate in blocks of this much simulation time; the summary
+    /// gains `observables` (mean and standard error of the blocks).
+    #[arg(long = "observe-every", allow_negative_numbers = true)]
+    pub observe_every: Option<f64>,
+    /// Where the observed blocks start (default: the start of the run), so that the gas can
+    /// settle first.
+    #[arg(long = "observe-from", allow_negative_numbers = true)]
+    pub observe_from: Option<f64>,
 }
 
 impl RunArgs {
@@ -134,6 +143,8 @@ impl RunArgs {
             checkpoint_every: None,
             samples: None,
             sample_every: None,
+            observe_every: None,
+            observe_from: None,
         }
     }
 }
@@ -429,12 +440,14 @@ pub fn run_from(
         Some(p) => Some(Samples::create(p)?),
         None => None,
     };
+    let mut observables = observables(a, scenario, &cfg)?;
     let report = {
         let mut sinks = Sinks {
             trace: trace.as_mut(),
             progress: progress.as_mut(),
             saver: saver.as_ref(),
             samples: samples.as_mut(),
+            observables: observables.as_mut(),
         };
         execute(scenario, &cfg, &mut sinks)
     };
@@ -465,11 +478,44 @@ pub fn run_from(
     if let Some(c) = from {
         count_from(&mut report.summary, c);
     }
+    report.summary.observables = observables.map(|o| o.finish(report.outcome.t));
     if let Some(p) = &a.final_state {
         write_final_state(p, &report.outcome, scenario)?;
     }
     print_summary(a, &report.summary)?;
     interrupted(&interrupt, report.outcome.t)
+}
+
+/// The observables `--observe-every` and `--observe-from` ask for, checked against the run.
+fn observables(
+    a: &RunArgs,
+    scenario: &Scenario,
+    cfg: &RunConfig,
+) -> Result<Option<poolsim::observe::Observables>, Failure> {
+    let Some(every) = a.observe_every else {
+        return match a.observe_from {
+            Some(_) => Err(usage("--observe-from: needs --observe-every")),
+            None => Ok(None),
+        };
+    };
+    let start = cfg.span.start;
+    let from = a.observe_from.unwrap_or(start);
+    if !(every.is_finite() && every > 0.0) {
+        return Err(usage(format!(
+            "--observe-every: must be a positive number, got {every}"
+        )));
+    }
+    if !(from.is_finite() && from >= start && from + every <= cfg.until) {
+        return Err(usage(format!(
+            "--observe-from: the first block, from {from} to {}, must lie within the run, from \
+             {start} to {}",
+            from + every,
+            cfg.until
+        )));
+    }
+    Ok(Some(poolsim::observe::Observables::new(
+        scenario, start, from, every,
+    )))
 }
 
 /// The summary of a run taken up from checkpoint `c` counts the events before it, and the
@@ -553,6 +599,7 @@ pub struct Sinks<'a> {
     pub progress: Option<&'a mut Progress>,
     pub saver: Option<&'a Saver>,
     pub samples: Option<&'a mut Samples>,
+    pub observables: Option<&'a mut poolsim::observe::Observables>,
 }
 
 /// The samples file: extended XYZ frames written as the run reaches each sample time. The first
@@ -598,11 +645,14 @@ impl Observer for Sinks<'_> {
         if let Some(p) = &mut self.progress {
             p.on_event(ev, world)?;
         }
+        if let Some(o) = &mut self.observables {
+            o.on_event(ev, world)?;
+        }
         Ok(())
     }
 
     fn reads_balls(&self) -> bool {
-        self.progress.as_ref().is_some_and(|p| p.reads_balls())
+        self.observables.is_some() || self.progress.as_ref().is_some_and(|p| p.reads_balls())
     }
 
     fn on_checkpoint(&mut self, checkpoint: Checkpoint) -> Result<(), RunError> {
@@ -682,6 +732,23 @@ pub fn human_summary(s: &RunSummary) -> String {
             st.rollbacks,
             100.0 * tw.remote_fraction,
             st.gvt_rounds
+        ));
+    }
+    if let Some(o) = &s.observables {
+        lines.push(format!(
+            "observed      {} blocks of {:?} from t = {:?}: Z = {:.5} ± {:.5}, P = {:.6e} ± {:.1e} \
+             (cushions {:.6e} ± {:.1e}), kT = {:.6e}, {:.4} collisions per ball and unit time",
+            o.blocks,
+            o.every,
+            o.from,
+            o.z.mean,
+            o.z.error,
+            o.pressure.mean,
+            o.pressure.error,
+            o.pressure_walls.mean,
+            o.pressure_walls.error,
+            o.kt.mean,
+            o.collision_rate.mean
         ));
     }
     if let Some(i) = &s.interrupted {
