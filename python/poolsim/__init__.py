@@ -223,6 +223,7 @@ def _ask(
     sample_every: float | None,
     events: bool,
     params: dict[str, Any],
+    observe: tuple[float | None, float | None] = (None, None),
 ) -> tuple[str, dict[str, Any]]:
     for name, value, least in [("balls", params.get("balls"), 1), ("seed", params.get("seed"), 0),
                                ("workers", workers, 1)]:
@@ -245,6 +246,8 @@ def _ask(
         "auto_sectors": sectors == "auto",
         "check": check,
         "sample_every": sample_every,
+        "observe_every": observe[0],
+        "observe_from": observe[1],
         "events": events,
         "balls": params.get("balls"),
         "seed": params.get("seed"),
@@ -265,6 +268,8 @@ def run(
     sectors: str | tuple[int, int] | None = None,
     check: bool = False,
     sample_every: float | None = None,
+    observe_every: float | None = None,
+    observe_from: float | None = None,
     events: bool = True,
     balls: int | None = None,
     seed: int | None = None,
@@ -278,12 +283,14 @@ def run(
     ``"objects"`` or ``"time-warp"`` (``workers`` threads); ``sectors`` (``"auto"`` or
     ``(nx, ny)``) runs the objects on a sectored table. ``check`` checks invariants at every
     event. ``balls``, ``seed``, ``area_fraction``, ``radius`` and ``speed_max`` are the
-    built-in generators' parameters. The engine runs with Python's lock released, so threads
-    can run simulations side by side.
+    built-in generators' parameters. ``observe_every`` (from ``observe_from``) adds the
+    pressure, the compressibility factor ``z``, the temperature ``kt`` and the collision rate,
+    each a block mean with its standard error, to ``summary["observables"]``. The engine runs
+    with Python's lock released, so threads can run simulations side by side.
     """
     spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, sample_every, events,
                      dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
-                          speed_max=speed_max))
+                          speed_max=speed_max), (observe_every, observe_from))
     d = _native.run(spec, ask)
     return Result(
         summary=json.loads(d["summary"]),
@@ -344,7 +351,7 @@ def stream(
 ) -> EventStream:
     """Starts a run in the background and returns its events in chunks of at most ``chunk``.
 
-    Takes :func:`run`'s arguments (but samples); bad input raises ``ValueError`` here, an error
+    Takes :func:`run`'s arguments (but samples and observables); bad input raises ``ValueError`` here, an error
     of the run itself when the chunk it stopped at is read.
     """
     spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, None, True,

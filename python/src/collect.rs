@@ -4,6 +4,7 @@ use numpy::PyArray1;
 use poolsim::engine::{
     BallState, Event, EventKind, Fixed, Frame, Observer, RunError, Table, World,
 };
+use poolsim::observe::{Observables, Observed};
 use poolsim::run::Report;
 use poolsim::scenario::Scenario;
 use pyo3::prelude::*;
@@ -100,6 +101,7 @@ impl Snapshot {
 /// Collects a whole run: its events (when asked), its samples and its final state.
 pub struct Collected {
     table: Table,
+    observables: Option<Observables>,
     events: Option<Columns>,
     samples: Vec<Snapshot>,
     last: Option<Snapshot>,
@@ -107,18 +109,20 @@ pub struct Collected {
 
 impl Collected {
     /// A collector for runs of `scenario`, keeping events or not.
-    pub fn new(scenario: &Scenario, events: bool) -> Collected {
+    pub fn new(scenario: &Scenario, events: bool, observables: Option<Observables>) -> Collected {
         Collected {
             table: Table::new(scenario),
+            observables,
             events: events.then(Columns::default),
             samples: Vec::new(),
             last: None,
         }
     }
 
-    /// Takes the final state from the run's report.
-    pub fn finish(&mut self, report: &Report) {
+    /// Takes the final state from the run's report; returns what the observables came to.
+    pub fn finish(&mut self, report: &Report) -> Option<Observed> {
         self.last = Some(Snapshot::of(report.outcome.t, &report.outcome.balls));
+        self.observables.take().map(|o| o.finish(report.outcome.t))
     }
 
     /// Everything as a dict for the Python package, with the summary's JSON text.
@@ -143,15 +147,18 @@ impl Collected {
 }
 
 impl Observer for Collected {
-    fn on_event(&mut self, ev: &Event, _: &dyn World) -> Result<(), RunError> {
+    fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
         if let Some(c) = &mut self.events {
             c.push(ev, &self.table);
         }
-        Ok(())
+        match &mut self.observables {
+            Some(o) => o.on_event(ev, world),
+            None => Ok(()),
+        }
     }
 
     fn reads_balls(&self) -> bool {
-        false
+        self.observables.is_some()
     }
 
     fn on_frame(&mut self, frame: &Frame, _: &Table) -> Result<(), RunError> {

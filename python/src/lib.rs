@@ -12,6 +12,7 @@ use numpy::{PyArray1, PyArrayMethods};
 use poolsim::engine::{EventKind, Span};
 use poolsim::model::layout::FixedNews;
 use poolsim::model::pool::NvDelay;
+use poolsim::observe::Observables;
 use poolsim::run::{execute, EngineKind, RunConfig, SectorChoice};
 use poolsim::scenario::builtin::Params;
 use poolsim::scenario::Scenario;
@@ -33,6 +34,8 @@ pub struct Ask {
     auto_sectors: bool,
     check: bool,
     sample_every: Option<f64>,
+    observe_every: Option<f64>,
+    observe_from: Option<f64>,
     events: bool,
     balls: Option<usize>,
     seed: Option<u64>,
@@ -194,13 +197,39 @@ pub fn columns<'py>(py: Python<'py>, c: Columns) -> PyResult<Bound<'py, PyDict>>
 fn run<'py>(py: Python<'py>, scenario: &str, ask: Ask) -> PyResult<Bound<'py, PyDict>> {
     let (summary, got) = py.detach(|| -> PyResult<(String, Collected)> {
         let (scenario, cfg) = ask.prepare(scenario)?;
-        let mut got = Collected::new(&scenario, ask.events);
-        let report = execute(&scenario, &cfg, &mut got).map_err(value_error)?;
-        got.finish(&report);
+        let observables = observables(&ask, &scenario, &cfg)?;
+        let mut got = Collected::new(&scenario, ask.events, observables);
+        let mut report = execute(&scenario, &cfg, &mut got).map_err(value_error)?;
+        report.summary.observables = got.finish(&report);
         let summary = serde_json::to_string(&report.summary).map_err(value_error)?;
         Ok((summary, got))
     })?;
     got.into_dict(py, summary)
+}
+
+/// The observables `observe_every` and `observe_from` ask for, checked against the run.
+fn observables(ask: &Ask, scenario: &Scenario, cfg: &RunConfig) -> PyResult<Option<Observables>> {
+    let Some(every) = ask.observe_every else {
+        return match ask.observe_from {
+            Some(_) => Err(value_error("observe_from: needs observe_every")),
+            None => Ok(None),
+        };
+    };
+    let from = ask.observe_from.unwrap_or(0.0);
+    if !(every.is_finite() && every > 0.0) {
+        return Err(value_error(format!(
+            "observe_every: must be a positive number, got {every}"
+        )));
+    }
+    if !(from.is_finite() && from >= 0.0 && from + every <= cfg.until) {
+        return Err(value_error(format!(
+            "observe_from: the first block, from {from} to {}, must lie within the run, from 0 \
+             to {}",
+            from + every,
+            cfg.until
+        )));
+    }
+    Ok(Some(Observables::new(scenario, 0.0, from, every)))
 }
 
 /// The trace names of the event kinds, indexed by the `kind` column.

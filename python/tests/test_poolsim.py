@@ -238,3 +238,15 @@ def test_a_state_is_drawn_with_its_table_and_balls():
     on_table = int(np.count_nonzero(r.final.pocket < 0))
     assert len(discs.get_paths()) == on_table
     assert len(ax.texts) == on_table
+
+
+def test_observables_are_the_command_lines():
+    r = poolsim.run("gas", balls=100, until=6, observe_every=2.0, observe_from=0.0)
+    o = r["observables"]
+    assert o["blocks"] == 3 and o["z"]["mean"] > 1.0
+    cli = cli_json("run", "gas", "--balls", "100", "--until", "6", "--observe-every", "2")
+    assert o == cli["observables"]
+    with pytest.raises(ValueError, match="observe_from: needs observe_every"):
+        poolsim.run("gas", observe_from=1.0)
+    with pytest.raises(ValueError, match="observe_every: must be a positive number"):
+        poolsim.run("gas", observe_every=-1.0)
