@@ -36,6 +36,7 @@ __all__ = [
     "Scenario",
     "State",
     "builtins",
+    "experiment",
     "phold",
     "run",
     "stream",
@@ -151,21 +152,26 @@ class Scenario:
         return cls(p.read_text(), str(p))
 
     @classmethod
-    def box(
+    def from_arrays(
         cls,
-        width: float,
-        height: float,
         positions: Sequence[Sequence[float]] | np.ndarray,
         velocities: Sequence[Sequence[float]] | np.ndarray,
+        cushions: Sequence[Sequence[Sequence[float]]] | np.ndarray,
+        *,
         radius: float | Sequence[float] | np.ndarray = 1.0,
         mass: float | Sequence[float] | np.ndarray = 1.0,
+        pockets: Sequence[Sequence[Sequence[float]]] | np.ndarray | None = None,
+        elasticity: float | Sequence[float] | np.ndarray = 1.0,
+        corner_elasticity: float | Sequence[float] | np.ndarray = 1.0,
         until: float = 10.0,
+        name: str = "arrays",
     ) -> Scenario:
-        """Balls in a ``width`` x ``height`` box of elastic cushions with its corner at the origin.
-
-        ``positions`` and ``velocities`` are ``(N, 2)``; ``radius`` and ``mass`` a number or one
-        per ball. Every number is written so that it reads back to the same bits.
-        """
+        """Balls on any table: ``positions`` and ``velocities`` ``(N, 2)``, ``radius`` and
+        ``mass`` a number or one per ball; ``cushions`` and ``pockets`` ``(M, 2, 2)`` segments
+        (from, to) wound with the table on their right, each with its ``elasticity`` (the
+        pockets' for their corners), as the TOML format has them (``docs/formats.md``). Every
+        number is written so that it reads back to the same bits; the library checks the
+        table when the scenario runs, and names the field it refuses."""
         pos = np.asarray(positions, dtype=float)
         vel = np.asarray(velocities, dtype=float)
         if pos.ndim != 2 or pos.shape[1] != 2 or vel.shape != pos.shape:
@@ -185,11 +191,33 @@ class Scenario:
                 f"radius = {num(rad[k])}",
                 f"mass = {num(mas[k])}",
             ]
-        w, h = num(width), num(height)
-        for a, b in [("0.0, 0.0", f"0.0, {h}"), (f"0.0, {h}", f"{w}, {h}"),
-                     (f"{w}, {h}", f"{w}, 0.0"), (f"{w}, 0.0", "0.0, 0.0")]:
-            lines += ["[[cushion]]", f"from = [{a}]", f"to = [{b}]"]
-        return cls("\n".join(lines) + "\n", "box")
+        for table, segments, e in [("cushion", cushions, elasticity),
+                                   ("pocket", pockets, corner_elasticity)]:
+            seg = np.asarray([] if segments is None else segments, dtype=float).reshape(-1, 2, 2)
+            el = np.broadcast_to(np.asarray(e, dtype=float), (len(seg),))
+            for (a, b), k in zip(seg, el):
+                lines += [f"[[{table}]]", f"from = [{num(a[0])}, {num(a[1])}]",
+                          f"to = [{num(b[0])}, {num(b[1])}]", f"elasticity = {num(k)}"]
+        return cls("\n".join(lines) + "\n", name)
+
+    @classmethod
+    def box(
+        cls,
+        width: float,
+        height: float,
+        positions: Sequence[Sequence[float]] | np.ndarray,
+        velocities: Sequence[Sequence[float]] | np.ndarray,
+        radius: float | Sequence[float] | np.ndarray = 1.0,
+        mass: float | Sequence[float] | np.ndarray = 1.0,
+        until: float = 10.0,
+    ) -> Scenario:
+        """Balls in a ``width`` x ``height`` box of elastic cushions with its corner at the
+        origin (:meth:`from_arrays` with the box's four sides)."""
+        w, h = float(width), float(height)
+        sides = [[(0.0, 0.0), (0.0, h)], [(0.0, h), (w, h)], [(w, h), (w, 0.0)],
+                 [(w, 0.0), (0.0, 0.0)]]
+        return cls.from_arrays(positions, velocities, sides, radius=radius, mass=mass,
+                               until=until, name="box")
 
 
 def _toml_float(x: float) -> str:
@@ -451,3 +479,27 @@ def to_gsd(path: str | Path, states: State | Sequence[State], table: Table) -> N
             frame.particles.mass = s.mass[on].astype(np.float32)
             frame.log["poolsim/t"] = np.array([s.t], dtype=np.float64)
             f.append(frame)
+
+
+def experiment(
+    which: str = "thesis",
+    out: str | Path = "experiment",
+    *,
+    quick: bool = False,
+    seeds: int | None = None,
+    balls: Sequence[int] | None = None,
+    font: str | Path | None = None,
+) -> dict[str, Any]:
+    """Runs ``poolsim experiment``: ``"thesis"`` (chapter 6's tables 5-10 and chapter 7's
+    figures 17-18 beside the thesis' own numbers) or ``"reversal"`` (the reversal error against
+    the quitting time, 4.6-4.7), writing tables, figures and a report into ``out``. ``quick``
+    runs the reduced grid CI runs; ``seeds`` and ``balls`` (square numbers) set the thesis'
+    grid. Returns the data the run wrote (``results.json``, or ``reversal.json``)."""
+    _whole("seeds", seeds, 1)
+    for b in balls or []:
+        _whole("balls", b, 1)
+    _native.experiment(which, Path(out), quick=quick, seeds=seeds,
+                       balls=None if balls is None else list(balls),
+                       font=None if font is None else Path(font))
+    name = "results.json" if which == "thesis" else "reversal.json"
+    return json.loads((Path(out) / name).read_text())

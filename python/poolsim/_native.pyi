@@ -20,6 +20,20 @@ def phold(
     partitions: int | None = ...,
 ) -> str: ...
 
+def experiment(
+    which: str,
+    out: Any,
+    *,
+    quick: bool = ...,
+    seeds: int | None = ...,
+    balls: list[int] | None = ...,
+    font: Any = ...,
+) -> None: ...
+def write_xyz(
+    path: str, frames: list[tuple[Any, ...]], lo: tuple[float, float], hi: tuple[float, float]
+) -> None: ...
+def read_xyz(path: str) -> list[dict[str, Any]]: ...
+
 class Stream:
     def __iter__(self) -> Iterator[dict[str, Any]]: ...
     def __next__(self) -> dict[str, Any]: ...

@@ -354,6 +354,40 @@ fn check_phold(
     Ok(())
 }
 
+/// Runs one of the command line's experiments (`poolsim experiment`), writing its tables,
+/// figures, data and report into `out`, with the lock released.
+#[pyfunction]
+#[pyo3(signature = (which, out, *, quick=false, seeds=None, balls=None, font=None))]
+fn experiment(
+    py: Python<'_>,
+    which: &str,
+    out: std::path::PathBuf,
+    quick: bool,
+    seeds: Option<u64>,
+    balls: Option<Vec<usize>>,
+    font: Option<std::path::PathBuf>,
+) -> PyResult<()> {
+    use poolsim::experiment::{ExperimentOptions, Which};
+    let which = match which {
+        "thesis" => Which::Thesis,
+        "reversal" => Which::Reversal,
+        other => {
+            return Err(value_error(format!(
+                "which: thesis or reversal, got {other:?}"
+            )))
+        }
+    };
+    let options = ExperimentOptions {
+        which,
+        out,
+        seeds,
+        balls,
+        quick,
+        font,
+    };
+    py.detach(|| poolsim::experiment::run(&options, &mut |_| {}).map_err(value_error))
+}
+
 /// The module.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -361,6 +395,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(event_kinds, m)?)?;
     m.add_function(wrap_pyfunction!(builtins, m)?)?;
     m.add_function(wrap_pyfunction!(phold, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment, m)?)?;
     m.add_function(wrap_pyfunction!(stream::stream, m)?)?;
     m.add_class::<stream::Stream>()?;
     m.add_function(wrap_pyfunction!(interop::write_xyz, m)?)?;

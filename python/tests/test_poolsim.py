@@ -250,3 +250,28 @@ def test_observables_are_the_command_lines():
         poolsim.run("gas", observe_from=1.0)
     with pytest.raises(ValueError, match="observe_every: must be a positive number"):
         poolsim.run("gas", observe_every=-1.0)
+
+
+def test_a_pool_table_from_arrays_runs_as_the_toml_one():
+    # the built-in racked break, rebuilt from its own arrays
+    r = poolsim.run("pool", until=0.0)
+    start = r.final
+    sc = poolsim.Scenario.from_arrays(
+        start.position, start.velocity, r.table.cushions, radius=start.radius, mass=start.mass,
+        pockets=r.table.pockets, until=5.0,
+    )
+    again = poolsim.run(sc)
+    reference = poolsim.run("pool")
+    assert np.array_equal(again.events, reference.events)
+    assert np.array_equal(again.final.position, reference.final.position)
+    bad = poolsim.Scenario.from_arrays([[1.0, 1.0]], [[0.0, 0.0]], [[[0, 0], [0, 0]]])
+    with pytest.raises(ValueError, match=r"cushion\[1\]"):
+        poolsim.run(bad)
+
+
+def test_the_thesis_experiment_runs_from_python(tmp_path):
+    results = poolsim.experiment("thesis", tmp_path / "thesis", quick=True)
+    assert (tmp_path / "thesis" / "report.md").exists()
+    assert results["plan"]["balls"] == [4, 16]
+    with pytest.raises(ValueError, match="which: thesis or reversal"):
+        poolsim.experiment("nope", tmp_path / "x")
