@@ -765,6 +765,49 @@ const TABLE: &[(&str, &str, &str, &str, &str)] = &[
         "4413 224 0 0",
         "3681718 228868 265864 9053 35502 24898 404 0 0 0 8828 4245903",
     ),
+    // the disk fluid's start: 400 disks on a triangular lattice at 0.5, Maxwell velocities
+    (
+        "disks",
+        "event-list",
+        "1e55fabdf55dc08c",
+        "7089 538 0 0",
+        "0 0 0 0 0 0 0 0 0 0 0 0",
+    ),
+    (
+        "disks",
+        "time-step",
+        "ae8939796cfc6232",
+        "7072 510 0 0",
+        "0 0 0 0 0 0 0 0 0 0 0 0",
+    ),
+    (
+        "disks",
+        "objects",
+        "1e55fabdf55dc08c",
+        "7089 538 0 0",
+        "6011948 454260 431746 0 0 0 0 0 0 0 0 6897954",
+    ),
+    (
+        "disks",
+        "sectored",
+        "1e55fabdf55dc08c",
+        "7089 538 0 0",
+        "463072 99310 173644 22907 48424 48798 597 0 0 0 14180 856155",
+    ),
+    (
+        "disks",
+        "time-warp",
+        "1e55fabdf55dc08c",
+        "7089 538 0 0",
+        "6011948 454260 431746 0 0 0 0 0 0 0 0 6897954",
+    ),
+    (
+        "disks",
+        "time-warp-sectored",
+        "1e55fabdf55dc08c",
+        "7089 538 0 0",
+        "463072 99310 173644 22907 48424 48798 597 0 0 0 14180 856155",
+    ),
 ];
 
 fn scenario(name: &str) -> Scenario {

@@ -282,6 +282,9 @@ def _ask(
         "area_fraction": params.get("area_fraction"),
         "radius": params.get("radius"),
         "speed_max": params.get("speed_max"),
+        "lattice": params.get("lattice"),
+        "temperature": params.get("temperature"),
+        "mixture": params.get("mixture"),
     }
     return spec, ask
 
@@ -304,21 +307,27 @@ def run(
     area_fraction: float | None = None,
     radius: float | None = None,
     speed_max: float | None = None,
+    lattice: str | None = None,
+    temperature: float | None = None,
+    mixture: tuple[float, float] | None = None,
 ) -> Result:
     """Runs a scenario to ``until`` (default: the scenario's own end) and returns its results.
 
     ``engine`` is ``"event-list"`` (the reference), ``"time-step"`` (needs ``dt``),
     ``"objects"`` or ``"time-warp"`` (``workers`` threads); ``sectors`` (``"auto"`` or
     ``(nx, ny)``) runs the objects on a sectored table. ``check`` checks invariants at every
-    event. ``balls``, ``seed``, ``area_fraction``, ``radius`` and ``speed_max`` are the
-    built-in generators' parameters. ``observe_every`` (from ``observe_from``) adds the
+    event. ``balls``, ``seed``, ``area_fraction``, ``radius``, ``speed_max``, ``lattice``
+    (``"triangular"`` or ``"square"``), ``temperature`` and ``mixture`` (``(F, Q)``: a fraction F
+    of the disks Q times as wide) are the built-in generators' parameters (``builtins()`` says
+    which each takes). ``observe_every`` (from ``observe_from``) adds the
     pressure, the compressibility factor ``z``, the temperature ``kt`` and the collision rate,
     each a block mean with its standard error, to ``summary["observables"]``. The engine runs
     with Python's lock released, so threads can run simulations side by side.
     """
     spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, sample_every, events,
                      dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
-                          speed_max=speed_max), (observe_every, observe_from))
+                          speed_max=speed_max, lattice=lattice, temperature=temperature,
+                          mixture=mixture), (observe_every, observe_from))
     d = _native.run(spec, ask)
     return Result(
         summary=json.loads(d["summary"]),
@@ -376,6 +385,9 @@ def stream(
     area_fraction: float | None = None,
     radius: float | None = None,
     speed_max: float | None = None,
+    lattice: str | None = None,
+    temperature: float | None = None,
+    mixture: tuple[float, float] | None = None,
 ) -> EventStream:
     """Starts a run in the background and returns its events in chunks of at most ``chunk``.
 
@@ -384,7 +396,8 @@ def stream(
     """
     spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, None, True,
                      dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
-                          speed_max=speed_max))
+                          speed_max=speed_max, lattice=lattice, temperature=temperature,
+                          mixture=mixture))
     return EventStream(_native.stream(spec, ask, chunk))
 
 

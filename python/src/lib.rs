@@ -42,17 +42,34 @@ pub struct Ask {
     area_fraction: Option<f64>,
     radius: Option<f64>,
     speed_max: Option<f64>,
+    lattice: Option<String>,
+    temperature: Option<f64>,
+    mixture: Option<(f64, f64)>,
 }
 
 impl Ask {
     /// The scenario and the run's settings, checked.
     pub fn prepare(&self, spec: &str) -> PyResult<(Scenario, RunConfig)> {
+        use poolsim::scenario::builtin::{Lattice, Mixture};
+        let lattice = match self.lattice.as_deref() {
+            None => None,
+            Some("triangular") => Some(Lattice::Triangular),
+            Some("square") => Some(Lattice::Square),
+            Some(other) => {
+                return Err(value_error(format!(
+                    "lattice: triangular or square, got {other:?}"
+                )))
+            }
+        };
         let params = Params {
             balls: self.balls,
             seed: self.seed,
             area_fraction: self.area_fraction,
             radius: self.radius,
             speed_max: self.speed_max,
+            lattice,
+            temperature: self.temperature,
+            mixture: self.mixture.map(|(large, ratio)| Mixture { large, ratio }),
         };
         let scenario = scenario_of(spec, self.toml.as_deref(), &params)?;
         let cfg = config_of(self, &scenario)?;

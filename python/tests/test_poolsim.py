@@ -275,3 +275,20 @@ def test_the_thesis_experiment_runs_from_python(tmp_path):
     assert results["plan"]["balls"] == [4, 16]
     with pytest.raises(ValueError, match="which: thesis or reversal"):
         poolsim.experiment("nope", tmp_path / "x")
+
+
+def test_a_disk_fluid_starts_at_its_temperature_with_no_momentum():
+    r = poolsim.run("disks", balls=500, area_fraction=0.5, temperature=2.0, mixture=(0.5, 1.4),
+                    lattice="square", until=0.0)
+    s = r.samples[0] if r.samples else r.final
+    assert np.allclose(np.sum(s.velocity, axis=0), 0.0, atol=1e-9)
+    assert np.isclose(0.5 * np.sum(s.mass * np.sum(s.velocity**2, axis=1)) / 500, 2.0)
+    assert sorted(set(s.radius)) == [1.0, 1.4]
+    assert np.count_nonzero(s.radius == 1.4) == 250
+    cli = cli_json("run", "disks", "--balls", "500", "--area-fraction", "0.5", "--temperature",
+                   "2", "--mixture", "0.5:1.4", "--lattice", "square", "--until", "0")
+    assert r.digest == cli["final_state_digest"]
+    with pytest.raises(ValueError, match="lattice: triangular or square"):
+        poolsim.run("disks", lattice="hexagonal")
+    with pytest.raises(ValueError, match="too dense"):
+        poolsim.run("disks", area_fraction=0.95)

@@ -39,19 +39,47 @@ pub struct Params {
     pub radius: Option<f64>,
     /// `--speed-max V`: speeds are drawn uniform in `[0, V)` (length per time).
     pub speed_max: Option<f64>,
+    /// `--lattice square|triangular`: the sites the balls start on.
+    pub lattice: Option<Lattice>,
+    /// `--temperature KT`: Maxwell-Boltzmann velocities with this kinetic energy per ball.
+    pub temperature: Option<f64>,
+    /// `--mixture F:Q`: a fraction `F` of the balls large, their diameter `Q` times the others'.
+    pub mixture: Option<Mixture>,
+}
+
+/// The sites of a lattice start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lattice {
+    /// Rows and columns at one spacing.
+    Square,
+    /// Rows half a spacing apart in turn, `√3/2` spacings above each other: each site has six
+    /// neighbours (the densest packing of equal disks).
+    Triangular,
+}
+
+/// A binary mixture: a fraction of the balls large, by a diameter ratio.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mixture {
+    /// The fraction of the balls that are large, in `[0, 1]`.
+    pub large: f64,
+    /// The large balls' diameter over the small ones', at least 1.
+    pub ratio: f64,
 }
 
 /// The most balls a generator will lay out (about 5 GB of ball specs); more is refused with an
 /// error rather than an allocation failure.
 pub const MAX_BALLS: usize = 100_000_000;
 
-const BALLS: &str = "--balls";
-const SEED: &str = "--seed";
-const AREA: &str = "--area-fraction";
-const RADIUS: &str = "--radius";
+pub(super) const BALLS: &str = "--balls";
+pub(super) const SEED: &str = "--seed";
+pub(super) const AREA: &str = "--area-fraction";
+pub(super) const RADIUS: &str = "--radius";
 const SPEED: &str = "--speed-max";
+pub(super) const LATTICE: &str = "--lattice";
+pub(super) const TEMPERATURE: &str = "--temperature";
+pub(super) const MIXTURE: &str = "--mixture";
 
-const DEFAULT_SEED: u64 = 1;
+pub(super) const DEFAULT_SEED: u64 = 1;
 
 const GAS_BALLS: usize = 36;
 const GAS_RADIUS: f64 = 30.0;
@@ -65,7 +93,7 @@ const REVERSAL_SPEED: f64 = 100.0;
 const REVERSAL_UNTIL: f64 = 3.0;
 
 /// Centres closer than `2r · (1 + GAP)` count as too close for a generated layout.
-const GAP: f64 = 1e-9;
+pub(super) const GAP: f64 = 1e-9;
 
 /// One built-in: its name, its description and its generator.
 struct Builtin {
@@ -82,7 +110,7 @@ const IMPLOSION_FRACTION: f64 = 0.5;
 const IMPLOSION_SIDE: f64 = 100.0;
 const IMPLOSION_UNTIL: f64 = 3.0;
 
-const BUILTINS: [Builtin; 6] = [
+const BUILTINS: [Builtin; 7] = [
     Builtin {
         name: "plate1",
         describe: || {
@@ -145,6 +173,11 @@ const BUILTINS: [Builtin; 6] = [
         },
         build: implosion,
     },
+    Builtin {
+        name: "disks",
+        describe: super::disks::describe,
+        build: super::disks::disks,
+    },
 ];
 
 /// Name and one-line description (with its defaults) of every built-in, in listing order.
@@ -177,7 +210,7 @@ pub fn build(name: &str, p: &Params) -> Result<Scenario, Invalid> {
     }
 }
 
-fn bad(field: &str, message: String) -> Invalid {
+pub(super) fn bad(field: &str, message: String) -> Invalid {
     Invalid {
         field: field.into(),
         message,
@@ -185,13 +218,16 @@ fn bad(field: &str, message: String) -> Invalid {
 }
 
 /// Rejects every parameter given that `name` does not take.
-fn allow(p: &Params, name: &str, takes: &[&str]) -> Result<(), Invalid> {
+pub(super) fn allow(p: &Params, name: &str, takes: &[&str]) -> Result<(), Invalid> {
     let given = [
         (BALLS, p.balls.is_some()),
         (SEED, p.seed.is_some()),
         (AREA, p.area_fraction.is_some()),
         (RADIUS, p.radius.is_some()),
         (SPEED, p.speed_max.is_some()),
+        (LATTICE, p.lattice.is_some()),
+        (TEMPERATURE, p.temperature.is_some()),
+        (MIXTURE, p.mixture.is_some()),
     ];
     for (flag, set) in given {
         if set && !takes.contains(&flag) {
@@ -209,7 +245,7 @@ fn allow(p: &Params, name: &str, takes: &[&str]) -> Result<(), Invalid> {
     Ok(())
 }
 
-fn radius_param(p: &Params, default: f64) -> Result<f64, Invalid> {
+pub(super) fn radius_param(p: &Params, default: f64) -> Result<f64, Invalid> {
     let r = p.radius.unwrap_or(default);
     if r.is_finite() && r > 0.0 {
         Ok(r)
@@ -246,7 +282,7 @@ fn random_velocity(rng: &mut ChaCha8Rng, vmax: f64) -> Vec2 {
 
 /// Four cushions of elasticity 1 around the rectangle `[0, w] × [0, h]`, clockwise from the
 /// left side.
-fn box_cushions(w: f64, h: f64) -> Vec<CushionSpec> {
+pub(super) fn box_cushions(w: f64, h: f64) -> Vec<CushionSpec> {
     let corners = [
         Vec2::new(0.0, 0.0),
         Vec2::new(0.0, h),
@@ -328,7 +364,7 @@ fn ceil_sqrt(n: usize) -> usize {
 /// row and the spacing is `side / need`. Rows are offset by half a spacing and `d·√3/2` apart,
 /// and the walls stand half a spacing beyond the outermost centres, so a spacing `d > 2r` keeps
 /// every ball clear of its neighbours and of the walls.
-fn triangular_rows(n: usize) -> (usize, f64) {
+pub(super) fn triangular_rows(n: usize) -> (usize, f64) {
     let pitch = 3f64.sqrt() / 2.0;
     let k = (n as f64).sqrt().ceil() as usize;
     let mut best = (1, f64::INFINITY);
@@ -678,7 +714,15 @@ mod tests {
     fn every_builtin_builds_validates_and_is_named() {
         assert_eq!(
             names(),
-            ["plate1", "gas", "reversal", "pool", "cradle", "implosion"]
+            [
+                "plate1",
+                "gas",
+                "reversal",
+                "pool",
+                "cradle",
+                "implosion",
+                "disks"
+            ]
         );
         for (name, description) in list() {
             assert!(!description.is_empty() && !description.contains('\n'));

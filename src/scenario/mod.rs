@@ -6,6 +6,7 @@
 //! positive, elasticities lie in `[0, 1]`, no segment has zero length and no two balls overlap.
 
 pub mod builtin;
+mod disks;
 pub mod toml;
 
 use crate::geometry::{Trajectory, Vec2};

@@ -25,6 +25,41 @@ pub struct GenArgs {
     /// Speeds are drawn uniform in [0, V) (gas, reversal).
     #[arg(long = "speed-max")]
     pub speed_max: Option<f64>,
+    /// The lattice the disks start on: triangular or square (disks).
+    #[arg(long, value_enum)]
+    pub lattice: Option<LatticeArg>,
+    /// Maxwell-Boltzmann velocities with this kinetic energy per disk, zero total momentum
+    /// (disks).
+    #[arg(long, allow_negative_numbers = true)]
+    pub temperature: Option<f64>,
+    /// A binary mixture F:Q: a fraction F of the disks large, Q times as wide (disks).
+    #[arg(long, value_parser = parse_mixture)]
+    pub mixture: Option<builtin::Mixture>,
+}
+
+/// `--lattice`: the sites a start's disks stand on.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LatticeArg {
+    /// Six neighbours per site.
+    Triangular,
+    /// Four neighbours per site.
+    Square,
+}
+
+/// Parses `--mixture F:Q`.
+fn parse_mixture(text: &str) -> Result<builtin::Mixture, String> {
+    let (f, q) = text
+        .split_once(':')
+        .ok_or_else(|| format!("expected F:Q (a fraction and a diameter ratio), got {text:?}"))?;
+    let number = |s: &str| {
+        s.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("expected F:Q (a fraction and a diameter ratio), got {text:?}"))
+    };
+    Ok(builtin::Mixture {
+        large: number(f)?,
+        ratio: number(q)?,
+    })
 }
 
 impl GenArgs {
@@ -35,6 +70,12 @@ impl GenArgs {
             area_fraction: self.area_fraction,
             radius: self.radius,
             speed_max: self.speed_max,
+            lattice: self.lattice.map(|l| match l {
+                LatticeArg::Triangular => builtin::Lattice::Triangular,
+                LatticeArg::Square => builtin::Lattice::Square,
+            }),
+            temperature: self.temperature,
+            mixture: self.mixture,
         }
     }
 }

@@ -1,0 +1,274 @@
+//! The built-in `disks`: a hard-disk fluid's start for physics runs. Disks on a square or
+//! triangular lattice in a square box of elastic cushions, at a given area fraction, with
+//! Maxwell-Boltzmann velocities at a given temperature and zero total momentum, one size or a
+//! binary mixture.
+//!
+//! A lattice is not a fluid: run it until it has forgotten the lattice (a few collisions per
+//! disk; at area fraction 0.5 about 5 time units at kT = 1 and unit radius), then start
+//! measuring (`--observe-from`), or start a new run from its final state.
+
+use super::builtin::{
+    allow, bad, box_cushions, radius_param, triangular_rows, Lattice, Mixture, Params, AREA, BALLS,
+    DEFAULT_SEED, GAP, LATTICE, MIXTURE, RADIUS, SEED, TEMPERATURE,
+};
+use super::{BallSpec, Invalid, Scenario};
+use crate::geometry::Vec2;
+use rand::seq::SliceRandom;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::f64::consts::PI;
+
+const DISKS_BALLS: usize = 400;
+const DISKS_AREA: f64 = 0.5;
+const DISKS_RADIUS: f64 = 1.0;
+const DISKS_TEMPERATURE: f64 = 1.0;
+const DISKS_UNTIL: f64 = 10.0;
+
+/// The one-line description, with the defaults.
+pub fn describe() -> String {
+    format!(
+        "a hard-disk fluid's start: {BALLS} {DISKS_BALLS} disks ({RADIUS} {DISKS_RADIUS}, mass 1) \
+         on a {LATTICE} triangular|square lattice in a square box of elastic cushions at \
+         {AREA} {DISKS_AREA}, Maxwell-Boltzmann velocities at {TEMPERATURE} {DISKS_TEMPERATURE} \
+         with zero total momentum, {MIXTURE} F:Q for a fraction F of large disks Q times as \
+         wide ({SEED} {DEFAULT_SEED}); until {DISKS_UNTIL}"
+    )
+}
+
+/// Builds the `disks` scenario.
+pub fn disks(p: &Params) -> Result<Scenario, Invalid> {
+    allow(
+        p,
+        "disks",
+        &[BALLS, SEED, AREA, RADIUS, LATTICE, TEMPERATURE, MIXTURE],
+    )?;
+    let n = p.balls.unwrap_or(DISKS_BALLS);
+    if !(2..=super::builtin::MAX_BALLS).contains(&n) {
+        return Err(bad(
+            BALLS,
+            format!(
+                "must be a whole number from 2 to {} (zero momentum needs two), got {n}",
+                super::builtin::MAX_BALLS
+            ),
+        ));
+    }
+    let phi = p.area_fraction.unwrap_or(DISKS_AREA);
+    if !(phi.is_finite() && phi > 0.0 && phi < 1.0) {
+        return Err(bad(
+            AREA,
+            format!("must lie strictly between 0 and 1, got {phi}"),
+        ));
+    }
+    let kt = p.temperature.unwrap_or(DISKS_TEMPERATURE);
+    if !(kt.is_finite() && kt > 0.0) {
+        return Err(bad(
+            TEMPERATURE,
+            format!("must be a positive number, got {kt}"),
+        ));
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed.unwrap_or(DEFAULT_SEED));
+    let radii = radii(p, n, &mut rng)?;
+    let covered: f64 = radii.iter().map(|r| PI * r * r).sum();
+    let side = (covered / phi).sqrt();
+    let rmax = radii.iter().copied().fold(0.0, f64::max);
+    let lattice = p.lattice.unwrap_or(Lattice::Triangular);
+    let sites = sites(lattice, n, rmax, side).map_err(|need| {
+        let most = (covered / (need * need) * 1e6).floor() / 1e6;
+        bad(
+            AREA,
+            format!(
+                "{phi} is too dense for {n} disks on a {} lattice in a walled box: at most {most}",
+                match lattice {
+                    Lattice::Square => "square",
+                    Lattice::Triangular => "triangular",
+                }
+            ),
+        )
+    })?;
+    let velocities = maxwell_boltzmann(n, kt, &mut rng);
+    let balls = sites
+        .into_iter()
+        .zip(radii)
+        .zip(velocities)
+        .map(|((position, radius), velocity)| BallSpec {
+            position,
+            velocity,
+            radius,
+            mass: 1.0,
+            fixed: None,
+            pocket: None,
+            colour: None,
+            label: None,
+        })
+        .collect();
+    Ok(Scenario {
+        name: "disks".into(),
+        until: DISKS_UNTIL,
+        balls,
+        cushions: box_cushions(side, side),
+        pockets: Vec::new(),
+        sectors: None,
+    })
+}
+
+/// Every disk's radius: the small radius, and for a mixture the large one on a random choice
+/// of `round(F N)` disks.
+fn radii(p: &Params, n: usize, rng: &mut ChaCha8Rng) -> Result<Vec<f64>, Invalid> {
+    let r = radius_param(p, DISKS_RADIUS)?;
+    let mut radii = vec![r; n];
+    if let Some(Mixture { large, ratio }) = p.mixture {
+        if !((0.0..=1.0).contains(&large) && ratio.is_finite() && ratio >= 1.0) {
+            return Err(bad(
+                MIXTURE,
+                format!(
+                    "the fraction must lie in [0, 1] and the diameter ratio be at least 1, got \
+                     {large}:{ratio}"
+                ),
+            ));
+        }
+        let k = (large * n as f64).round() as usize;
+        radii[..k].fill(ratio * r);
+        radii.shuffle(rng);
+    }
+    Ok(radii)
+}
+
+/// Sites for `n` disks of radius at most `r` in the box `[0, side]²`, row by row from the
+/// bottom, each at least a radius (and a hair) from the walls and two from the others. `Err`
+/// holds the smallest side that would take them.
+fn sites(lattice: Lattice, n: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
+    let d = 2.0 * r * (1.0 + GAP);
+    // columns per row, the rows' pitch and shift, and the extent in spacings
+    let (m, pitch, shift, need) = match lattice {
+        Lattice::Square => {
+            let k = (n as f64).sqrt().ceil() as usize;
+            (k, 1.0, 0.0, k as f64)
+        }
+        Lattice::Triangular => {
+            let (m, need) = triangular_rows(n);
+            (m, 3f64.sqrt() / 2.0, 0.5, need)
+        }
+    };
+    let spacing = side / need;
+    if spacing < d {
+        return Err(d * need);
+    }
+    let rows = n.div_ceil(m);
+    let width = (m as f64 - 1.0 + if rows > 1 { shift } else { 0.0 }) * spacing;
+    let height = (rows as f64 - 1.0) * pitch * spacing;
+    let (ox, oy) = ((side - width) / 2.0, (side - height) / 2.0);
+    let pts = (0..n)
+        .map(|k| {
+            let (j, i) = (k / m, k % m);
+            let x = ox + (i as f64 + if j % 2 == 1 { shift } else { 0.0 }) * spacing;
+            Vec2::new(x, oy + j as f64 * pitch * spacing)
+        })
+        .collect();
+    Ok(pts)
+}
+
+/// Velocities of `n` unit masses from the Maxwell-Boltzmann distribution at `kt`: normal
+/// components (Box-Muller), the mean removed so that the total momentum is zero, then scaled so
+/// that the kinetic energy is `n kt` (two degrees of freedom per disk).
+fn maxwell_boltzmann(n: usize, kt: f64, rng: &mut ChaCha8Rng) -> Vec<Vec2> {
+    let mut normal = || {
+        let u: f64 = rng.gen_range(f64::EPSILON..1.0);
+        let a: f64 = 2.0 * PI * rng.gen::<f64>();
+        let rho = (-2.0 * u.ln()).sqrt();
+        Vec2::new(rho * a.cos(), rho * a.sin())
+    };
+    let mut v: Vec<Vec2> = (0..n).map(|_| normal()).collect();
+    let mean = (1.0 / n as f64) * v.iter().fold(Vec2::ZERO, |s, &x| s + x);
+    for x in &mut v {
+        *x = *x - mean;
+    }
+    let kinetic: f64 = v.iter().map(|x| 0.5 * x.norm2()).sum();
+    let scale = (n as f64 * kt / kinetic).sqrt();
+    v.iter().map(|&x| scale * x).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with(f: impl FnOnce(&mut Params)) -> Result<Scenario, Invalid> {
+        let mut p = Params::default();
+        f(&mut p);
+        disks(&p)
+    }
+
+    #[test]
+    fn a_start_has_its_density_temperature_and_no_momentum() {
+        for lattice in [Lattice::Square, Lattice::Triangular] {
+            for (n, phi) in [(2, 0.1), (400, 0.5), (1000, 0.7), (37, 0.3)] {
+                let s = with(|p| {
+                    p.balls = Some(n);
+                    p.area_fraction = Some(phi);
+                    p.lattice = Some(lattice);
+                    p.temperature = Some(2.0);
+                })
+                .unwrap();
+                s.validate().unwrap();
+                let (lo, hi) = s.bounds();
+                let covered: f64 = s.balls.iter().map(|b| PI * b.radius * b.radius).sum();
+                let area = (hi.x - lo.x) * (hi.y - lo.y);
+                assert!(
+                    (covered / area - phi).abs() < 1e-12,
+                    "{lattice:?} {n} {phi}"
+                );
+                let p = s.balls.iter().fold(Vec2::ZERO, |a, b| a + b.velocity);
+                assert!(p.norm() < 1e-9 * n as f64, "{p:?}");
+                let k: f64 = s.balls.iter().map(|b| 0.5 * b.velocity.norm2()).sum();
+                assert!((k / (2.0 * n as f64) - 1.0).abs() < 1e-12, "{k}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_mixture_has_its_share_of_large_disks() {
+        let s = with(|p| {
+            p.balls = Some(1000);
+            p.mixture = Some(Mixture {
+                large: 0.5,
+                ratio: 1.4,
+            });
+            p.area_fraction = Some(0.6);
+        })
+        .unwrap();
+        s.validate().unwrap();
+        let large = s.balls.iter().filter(|b| b.radius == 1.4).count();
+        assert_eq!(large, 500);
+        assert_eq!(s.balls.iter().filter(|b| b.radius == 1.0).count(), 500);
+    }
+
+    #[test]
+    fn bad_values_name_their_flag() {
+        let err = |f: fn(&mut Params)| with(f).unwrap_err().field;
+        assert_eq!(err(|p| p.area_fraction = Some(0.95)), AREA);
+        assert_eq!(err(|p| p.temperature = Some(0.0)), TEMPERATURE);
+        assert_eq!(err(|p| p.balls = Some(1)), BALLS);
+        assert_eq!(
+            err(|p| p.mixture = Some(Mixture {
+                large: 0.5,
+                ratio: 0.5
+            })),
+            MIXTURE
+        );
+        let dense = with(|p| {
+            p.area_fraction = Some(0.88);
+            p.lattice = Some(Lattice::Square);
+        })
+        .unwrap_err();
+        assert!(dense.message.contains("at most 0.7"), "{}", dense.message);
+        // the other built-ins refuse the new parameters
+        let gas = super::super::builtin::build(
+            "gas",
+            &Params {
+                temperature: Some(1.0),
+                ..Params::default()
+            },
+        )
+        .unwrap_err();
+        assert_eq!(gas.field, TEMPERATURE);
+    }
+}
