@@ -488,16 +488,7 @@ fn gas(p: &Params) -> Result<Scenario, Invalid> {
     let mut rng = ChaCha8Rng::seed_from_u64(p.seed.unwrap_or(DEFAULT_SEED));
     let balls = positions
         .into_iter()
-        .map(|position| BallSpec {
-            position,
-            velocity: random_velocity(&mut rng, vmax),
-            radius: r,
-            mass: 1.0,
-            fixed: None,
-            pocket: None,
-            colour: None,
-            label: None,
-        })
+        .map(|position| BallSpec::moving(position, random_velocity(&mut rng, vmax), r, 1.0))
         .collect();
     Ok(Scenario {
         name: "gas".into(),
@@ -518,16 +509,9 @@ fn reversal(p: &Params) -> Result<Scenario, Invalid> {
     let mut balls = Vec::with_capacity(16);
     for j in 0..4 {
         for i in 0..4 {
-            balls.push(BallSpec {
-                position: Vec2::new(50.0 + 100.0 * i as f64, 50.0 + 100.0 * j as f64),
-                velocity: random_velocity(&mut rng, vmax),
-                radius: REVERSAL_RADIUS,
-                mass: 1.0,
-                fixed: None,
-                pocket: None,
-                colour: None,
-                label: None,
-            });
+            let at = Vec2::new(50.0 + 100.0 * i as f64, 50.0 + 100.0 * j as f64);
+            let velocity = random_velocity(&mut rng, vmax);
+            balls.push(BallSpec::moving(at, velocity, REVERSAL_RADIUS, 1.0));
         }
     }
     Ok(Scenario {

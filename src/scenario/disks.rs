@@ -90,16 +90,7 @@ pub fn disks(p: &Params) -> Result<Scenario, Invalid> {
         .into_iter()
         .zip(radii)
         .zip(velocities)
-        .map(|((position, radius), velocity)| BallSpec {
-            position,
-            velocity,
-            radius,
-            mass: 1.0,
-            fixed: None,
-            pocket: None,
-            colour: None,
-            label: None,
-        })
+        .map(|((position, radius), velocity)| BallSpec::moving(position, velocity, radius, 1.0))
         .collect();
     Ok(Scenario {
         name: "disks".into(),

@@ -50,6 +50,21 @@ pub struct BallSpec {
 }
 
 impl BallSpec {
+    /// A plain ball at the start: at `position` with `velocity`, of `radius` and `mass`, no
+    /// looks.
+    pub fn moving(position: Vec2, velocity: Vec2, radius: f64, mass: f64) -> BallSpec {
+        BallSpec {
+            position,
+            velocity,
+            radius,
+            mass,
+            fixed: None,
+            pocket: None,
+            colour: None,
+            label: None,
+        }
+    }
+
     /// A ball as a run holds it between events, for a run that takes that one up: on `traj`
     /// since the event of key `fixed`, in `pocket` if it dropped into one; no looks (the run
     /// copies them from its scenario).

@@ -48,6 +48,35 @@ impl<T: Time, M> Ranked for Item<T, M> {
     }
 }
 
+/// Pops the next message of `pending` that is not among the `cancelled` (which forgets it).
+#[inline]
+pub(crate) fn pop_live<T: Time, M>(
+    pending: &mut Queue<Item<T, M>>,
+    cancelled: &mut FxHashSet<Handle>,
+) -> Option<Pending<T, M>> {
+    while let Some(Item(p)) = pending.pop() {
+        if !(p.retractable && cancelled.remove(&p.handle())) {
+            return Some(p);
+        }
+    }
+    None
+}
+
+/// Drops cancelled messages from `pending` once they are half of it, so that memory follows
+/// the live messages (a cancelled message may lie far in the future); what is left in
+/// `cancelled` names messages already delivered, which no longer matter. Amortized O(1) per
+/// cancellation.
+pub(crate) fn sweep_cancelled<T: Time, M>(
+    pending: &mut Queue<Item<T, M>>,
+    cancelled: &mut FxHashSet<Handle>,
+) {
+    if cancelled.len() > 1024 && 2 * cancelled.len() > pending.len() {
+        let dead = &*cancelled;
+        pending.retain(|Item(p)| !(p.retractable && dead.contains(&p.handle())));
+        cancelled.clear();
+    }
+}
+
 /// Runs a model's objects one batch at a time in virtual-time order.
 pub struct Sequential<M: Model> {
     model: M,
@@ -123,25 +152,13 @@ impl<M: Model> Sequential<M> {
 
     /// Pops the next message that was not cancelled.
     fn pop_live(&mut self) -> Option<Pending<M::Time, M::Msg>> {
-        while let Some(Item(p)) = self.pending.pop() {
-            if !(p.retractable && self.cancelled.remove(&p.handle())) {
-                return Some(p);
-            }
-        }
-        None
+        pop_live(&mut self.pending, &mut self.cancelled)
     }
 
-    /// Drops cancelled messages from the pending set once they are half of it, so that memory
-    /// follows the live messages (a cancelled message may lie far in the future); what is
-    /// left in the set names messages already delivered, which no longer matter. Amortized
-    /// O(1) per cancellation.
+    /// Drops cancelled messages from the pending set once they are half of it
+    /// ([`sweep_cancelled`]).
     fn sweep_cancelled(&mut self) {
-        if self.cancelled.len() > 1024 && 2 * self.cancelled.len() > self.pending.len() {
-            let dead = &self.cancelled;
-            self.pending
-                .retain(|Item(p)| !(p.retractable && dead.contains(&p.handle())));
-            self.cancelled.clear();
-        }
+        sweep_cancelled(&mut self.pending, &mut self.cancelled);
     }
 
     /// Whether an interrupt asks the run to end.

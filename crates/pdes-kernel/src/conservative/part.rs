@@ -4,7 +4,7 @@
 use super::sync::{Boxes, FAILED};
 use crate::prefetch::{prefetch, prefetch_all};
 use crate::queue::Queue;
-use crate::sequential::Item;
+use crate::sequential::{pop_live, sweep_cancelled, Item};
 use crate::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
@@ -170,12 +170,7 @@ impl<M: Model> Part<M> {
 
     /// Pops the next message that was not cancelled.
     fn pop_live(&mut self) -> Option<Pending<M::Time, M::Msg>> {
-        while let Some(Item(p)) = self.pending.pop() {
-            if !(p.retractable && self.cancelled.remove(&p.handle())) {
-                return Some(p);
-            }
-        }
-        None
+        pop_live(&mut self.pending, &mut self.cancelled)
     }
 
     /// Takes the next batch of the window: every live message of the first pending receiver
@@ -282,12 +277,7 @@ impl<M: Model> Part<M> {
     /// Drops cancelled messages from the pending set once they are half of it (as the
     /// sequential executor does).
     fn sweep_cancelled(&mut self) {
-        if self.cancelled.len() > 1024 && 2 * self.cancelled.len() > self.pending.len() {
-            let dead = &self.cancelled;
-            self.pending
-                .retain(|Item(p)| !(p.retractable && dead.contains(&p.handle())));
-            self.cancelled.clear();
-        }
+        sweep_cancelled(&mut self.pending, &mut self.cancelled);
     }
 
     /// In chaos mode, now and then gives the core away, so that the workers' windows end in
