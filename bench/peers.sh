@@ -28,8 +28,9 @@
 # For every configuration and every round k = 1..K it runs, alternating kernels (each round starts
 # one kernel later than the last, so that a drift of the machine's speed falls on all alike):
 #   poolsim sequential (`--engine objects --partitions T`), poolsim Time Warp (T workers),
-#   ROSS sequential (--synch=1), ROSS optimistic (mpirun -np T, --synch=3),
-#   ROOT-Sim serial runtime, ROOT-Sim parallel runtime (T threads).
+#   poolsim conservative (T workers; lookahead > 0 only), ROSS sequential (--synch=1), ROSS
+#   optimistic (mpirun -np T, --synch=3), ROSS conservative (mpirun -np T, --synch=2; lookahead
+#   > 0 only), ROOT-Sim serial runtime, ROOT-Sim parallel runtime (T threads).
 # Committed events per second come from each tool's own output: poolsim's JSON (committed /
 # wall_seconds), ROSS's "Net Events Processed" over its "Running Time", and the model's committed
 # count over ROOT-Sim's "Simulation completed in S seconds". The table gives, per configuration and
@@ -229,7 +230,9 @@ EOF
 # ---------------------------------------------------------------------------------------------
 # Runs
 # ---------------------------------------------------------------------------------------------
-KERNELS=(poolsim-seq poolsim-tw ross-seq ross-opt rootsim-serial rootsim-par)
+KERNELS=(poolsim-seq poolsim-tw poolsim-cons ross-seq ross-opt ross-cons rootsim-serial rootsim-par)
+# the conservative executors need a positive lookahead: at lookahead 0 they are not run
+CONSERVATIVE=(poolsim-cons ross-cons)
 
 # run_kernel KERNEL OBJECTS REMOTE LOOKAHEAD END LOG TIMEOUT: runs one kernel once and prints
 # "STATUS COMMITTED TOOL_SECONDS WALL_SECONDS" (the last: the process's outer wall time).
@@ -240,17 +243,21 @@ run_kernel() {
     poolsim-seq)
       cmd=("$POOLSIM" phold --objects "$n" --events-per-object "$START_EVENTS" --remote "$r"
         --lookahead "$l" --mean "$MEAN" --end "$end" --engine objects --partitions "$THREADS" --json) ;;
-    poolsim-tw)
+    poolsim-tw|poolsim-cons)
+      local engine=time-warp
+      [[ $k == poolsim-cons ]] && engine=conservative
       cmd=("$POOLSIM" phold --objects "$n" --events-per-object "$START_EVENTS" --remote "$r"
-        --lookahead "$l" --mean "$MEAN" --end "$end" --engine time-warp --workers "$THREADS"
+        --lookahead "$l" --mean "$MEAN" --end "$end" --engine "$engine" --workers "$THREADS"
         --partitions "$THREADS" --json) ;;
     ross-seq)
       # shellcheck disable=SC2206 # ROSS_ARGS is split into words on purpose
       cmd=("$(ROSS_BIN)" --synch=1 --nlp="$n" --start-events="$START_EVENTS" --remote="$(ross_remote "$r")"
         --lookahead="$l" --mean="$(awk -v l="$l" -v m="$MEAN" 'BEGIN { print l + m }')" --end="$end" $ROSS_ARGS) ;;
-    ross-opt)
+    ross-opt|ross-cons)
+      local synch=3
+      [[ $k == ross-cons ]] && synch=2
       # shellcheck disable=SC2206
-      cmd=("${MPIRUN[@]}" "$(ROSS_BIN)" --synch=3 --nlp="$((n / THREADS))" --start-events="$START_EVENTS"
+      cmd=("${MPIRUN[@]}" "$(ROSS_BIN)" --synch="$synch" --nlp="$((n / THREADS))" --start-events="$START_EVENTS"
         --remote="$(ross_remote "$r")" --lookahead="$l"
         --mean="$(awk -v l="$l" -v m="$MEAN" 'BEGIN { print l + m }')" --end="$end" $ROSS_ARGS) ;;
     rootsim-serial|rootsim-par)
@@ -299,6 +306,9 @@ run_all() {
     for ((round = 1; round <= RUNS; round++)); do
       for ((i = 0; i < ${#KERNELS[@]}; i++)); do
         k=${KERNELS[$(((i + round - 1) % ${#KERNELS[@]}))]}
+        if [[ " ${CONSERVATIVE[*]} " == *" $k "* ]] && awk -v l="$l" 'BEGIN { exit !(l <= 0) }'; then
+          continue
+        fi
         tries=0
         while :; do
           tries=$((tries + 1))
@@ -337,10 +347,13 @@ rows = list(csv.DictReader(open(sys.argv[1])))
 T = sys.argv[2]
 names = {
     "poolsim-seq": "poolsim sequential", "poolsim-tw": f"poolsim Time Warp x{T}",
+    "poolsim-cons": f"poolsim conservative x{T}",
     "ross-seq": "ROSS sequential", "ross-opt": f"ROSS optimistic x{T} ranks",
+    "ross-cons": f"ROSS conservative x{T} ranks",
     "rootsim-serial": "ROOT-Sim serial", "rootsim-par": f"ROOT-Sim parallel x{T} thr",
 }
-own_seq = {"poolsim-tw": "poolsim-seq", "ross-opt": "ross-seq", "rootsim-par": "rootsim-serial"}
+own_seq = {"poolsim-tw": "poolsim-seq", "poolsim-cons": "poolsim-seq", "ross-opt": "ross-seq",
+           "ross-cons": "ross-seq", "rootsim-par": "rootsim-serial"}
 def fmt(x): return f"{x / 1e6:7.3f}"
 configs = []
 for r in rows:
@@ -361,6 +374,8 @@ for (c, n, rem, la, end) in configs:
     for k, name in names.items():
         rs = [r for r in rows if r["config"] == c and r["kernel"] == k]
         ok = [r for r in rs if r["status"] == "ok"]
+        if not rs:
+            continue  # a conservative kernel at lookahead 0
         hung = sum(int(r["tries"]) - 1 for r in rs)
         note = f"  ({hung} hung run(s) rerun)" if hung else ""
         if not ok:
