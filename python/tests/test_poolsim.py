@@ -292,3 +292,36 @@ def test_a_disk_fluid_starts_at_its_temperature_with_no_momentum():
         poolsim.run("disks", lattice="hexagonal")
     with pytest.raises(ValueError, match="too dense"):
         poolsim.run("disks", area_fraction=0.95)
+
+
+def test_pair_correlation_is_flat_for_random_points_and_zero_inside_a_disk():
+    from poolsim.analysis import pair_correlation
+
+    rng = np.random.default_rng(1)
+    n, side = 4000, 100.0
+    table = poolsim.Table(np.zeros((0, 2, 2)), np.zeros((0, 2, 2)), (0.0, 0.0), (side, side))
+    points = poolsim.State(0.0, rng.uniform(0, side, (n, 2)), np.zeros((n, 2)), np.ones(n),
+                           np.ones(n), -np.ones(n, dtype=np.int32))
+    r, g = pair_correlation(points, table, r_max=10.0, bins=10)
+    assert np.allclose(g, 1.0, atol=0.1), g
+    # a melted fluid at 0.5: no two centres closer than a diameter, a contact peak above 1
+    fluid = poolsim.run("disks", balls=900, area_fraction=0.5, until=20, events=False)
+    r, g = pair_correlation(fluid.final, fluid.table, r_max=6.0, bins=60)
+    assert np.all(g[r < 1.95] == 0.0)
+    assert g[(r > 2.0) & (r < 2.2)].max() > 2.0
+    assert abs(g[r > 5.0].mean() - 1.0) < 0.2
+    with pytest.raises(ValueError, match="r_max"):
+        pair_correlation(fluid.final, fluid.table, r_max=1e6)
+
+
+def test_the_mean_squared_displacement_grows_from_zero_then_levels_off():
+    from poolsim.analysis import mean_squared_displacement
+
+    r = poolsim.run("disks", balls=100, area_fraction=0.3, until=400, sample_every=10.0,
+                    events=False)
+    t, msd = mean_squared_displacement(r.samples)
+    assert t[0] == 0.0 and msd[0] == 0.0
+    assert msd[1] > 0 and msd[3] > msd[1]
+    (x0, _), (x1, _) = r.table.lo, r.table.hi
+    # bounded by the box: two uniform points in a square of side L are L^2 / 3 apart on average
+    assert msd[-10:].mean() < 0.5 * (x1 - x0) ** 2
