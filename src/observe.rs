@@ -79,6 +79,36 @@ pub struct Observed {
     pub pressure_walls: Estimate,
 }
 
+/// Why blocks cannot be observed over a run: each message reads after the name of the setting
+/// it is about ([`ObserveError::is_about_every`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ObserveError {
+    /// The block length is not a positive number.
+    #[error("must be a positive number, got {0}")]
+    Every(f64),
+    /// The first block does not lie within the run.
+    #[error(
+        "the first block, from {from} to {to}, must lie within the run, from {start} to {until}"
+    )]
+    From {
+        /// Where the first block starts.
+        from: f64,
+        /// Where it ends.
+        to: f64,
+        /// The run's start.
+        start: f64,
+        /// The run's end.
+        until: f64,
+    },
+}
+
+impl ObserveError {
+    /// Whether the error is about the block length (else about where the blocks start).
+    pub fn is_about_every(&self) -> bool {
+        matches!(self, ObserveError::Every(_))
+    }
+}
+
 /// One block's sums.
 #[derive(Clone, Copy, Debug, Default)]
 struct Block {
@@ -134,6 +164,29 @@ impl Observables {
                 .map(|c| (c.to - c.from).norm())
                 .sum(),
         }
+    }
+
+    /// Observables of a run of `scenario` from `start` to `until`, in blocks of `every` from
+    /// `from` (default: the start), refused unless at least one whole block fits.
+    pub fn over(
+        scenario: &Scenario,
+        (start, until): (f64, f64),
+        from: Option<f64>,
+        every: f64,
+    ) -> Result<Observables, ObserveError> {
+        let from = from.unwrap_or(start);
+        if !(every.is_finite() && every > 0.0) {
+            return Err(ObserveError::Every(every));
+        }
+        if !(from.is_finite() && from >= start && from + every <= until) {
+            return Err(ObserveError::From {
+                from,
+                to: from + every,
+                start,
+                until,
+            });
+        }
+        Ok(Observables::new(scenario, start, from, every))
     }
 
     /// The end of the block being summed.

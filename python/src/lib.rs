@@ -232,21 +232,16 @@ fn observables(ask: &Ask, scenario: &Scenario, cfg: &RunConfig) -> PyResult<Opti
             None => Ok(None),
         };
     };
-    let from = ask.observe_from.unwrap_or(0.0);
-    if !(every.is_finite() && every > 0.0) {
-        return Err(value_error(format!(
-            "observe_every: must be a positive number, got {every}"
-        )));
-    }
-    if !(from.is_finite() && from >= 0.0 && from + every <= cfg.until) {
-        return Err(value_error(format!(
-            "observe_from: the first block, from {from} to {}, must lie within the run, from 0 \
-             to {}",
-            from + every,
-            cfg.until
-        )));
-    }
-    Ok(Some(Observables::new(scenario, 0.0, from, every)))
+    Observables::over(scenario, (0.0, cfg.until), ask.observe_from, every)
+        .map(Some)
+        .map_err(|e| {
+            let name = if e.is_about_every() {
+                "observe_every"
+            } else {
+                "observe_from"
+            };
+            value_error(format!("{name}: {e}"))
+        })
 }
 
 /// The trace names of the event kinds, indexed by the `kind` column.

@@ -62,6 +62,31 @@ pub(crate) fn pop_live<T: Time, M>(
     None
 }
 
+/// Moves every further live message of `pending` to `to` at `time` into `batch`: the rest of
+/// the batch whose first message was just taken.
+#[inline]
+pub(crate) fn take_rest_of_batch<T: Time, M>(
+    pending: &mut Queue<Item<T, M>>,
+    cancelled: &mut FxHashSet<Handle>,
+    time: &VTime<T>,
+    to: u32,
+    batch: &mut Vec<Envelope<M>>,
+) {
+    while let Some(Item(p)) = pending.peek() {
+        if p.to != to || p.time != *time {
+            break;
+        }
+        let Some(p) = pop_live(pending, cancelled) else {
+            break;
+        };
+        if p.to != to || p.time != *time {
+            pending.push(Item(p), false);
+            break;
+        }
+        batch.push(p.env);
+    }
+}
+
 /// Drops cancelled messages from `pending` once they are half of it, so that memory follows
 /// the live messages (a cancelled message may lie far in the future); what is left in
 /// `cancelled` names messages already delivered, which no longer matter. Amortized O(1) per
@@ -197,17 +222,13 @@ impl<M: Model> Sequential<M> {
             let (time, to) = (first.time, first.to);
             let mut batch = std::mem::take(&mut self.batch);
             batch.push(first.env);
-            while let Some(Item(p)) = self.pending.peek() {
-                if p.to != to || p.time != time {
-                    break;
-                }
-                let Some(p) = self.pop_live() else { break };
-                if p.to != to || p.time != time {
-                    self.pending.push(Item(p), false);
-                    break;
-                }
-                batch.push(p.env);
-            }
+            take_rest_of_batch(
+                &mut self.pending,
+                &mut self.cancelled,
+                &time,
+                to,
+                &mut batch,
+            );
             // the next batch's object, most likely: its state loads while this batch runs
             if let Some(Item(next)) = self.pending.peek() {
                 let o = next.to as usize;

@@ -498,24 +498,17 @@ fn observables(
             None => Ok(None),
         };
     };
-    let start = cfg.span.start;
-    let from = a.observe_from.unwrap_or(start);
-    if !(every.is_finite() && every > 0.0) {
-        return Err(usage(format!(
-            "--observe-every: must be a positive number, got {every}"
-        )));
-    }
-    if !(from.is_finite() && from >= start && from + every <= cfg.until) {
-        return Err(usage(format!(
-            "--observe-from: the first block, from {from} to {}, must lie within the run, from \
-             {start} to {}",
-            from + every,
-            cfg.until
-        )));
-    }
-    Ok(Some(poolsim::observe::Observables::new(
-        scenario, start, from, every,
-    )))
+    let span = (cfg.span.start, cfg.until);
+    poolsim::observe::Observables::over(scenario, span, a.observe_from, every)
+        .map(Some)
+        .map_err(|e| {
+            let flag = if e.is_about_every() {
+                "--observe-every"
+            } else {
+                "--observe-from"
+            };
+            usage(format!("{flag}: {e}"))
+        })
 }
 
 /// The summary of a run taken up from checkpoint `c` counts the events before it, and the

@@ -184,7 +184,7 @@ impl<M: Model> Conservative<M> {
         ConservativeStats {
             workers: self.parts.len(),
             windows: self.windows,
-            batches: self.parts.iter().map(|p| p.batches).collect(),
+            batches: self.parts.iter().map(|p| p.stats.batches).collect(),
             remote_messages: self.parts.iter().map(|p| p.received).sum(),
             lookahead: self.model.lookahead(),
         }

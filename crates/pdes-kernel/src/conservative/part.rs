@@ -4,7 +4,7 @@
 use super::sync::{Boxes, FAILED};
 use crate::prefetch::{prefetch, prefetch_all};
 use crate::queue::Queue;
-use crate::sequential::{pop_live, sweep_cancelled, Item};
+use crate::sequential::{pop_live, sweep_cancelled, take_rest_of_batch, Item};
 use crate::{Ctx, Envelope, Handle, MessageStats, Model, Pending, VTime, RESERVED_PER_OBJECT};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
@@ -85,8 +85,6 @@ pub struct Part<M: Model> {
     pub error: Option<String>,
     /// Messages that arrived from other workers.
     pub received: u64,
-    /// Batches run.
-    pub batches: u64,
     /// Shakes the order of arrivals and the timing of the workers (chaos mode).
     chaos: Option<Pcg64Mcg>,
     batch: Vec<Envelope<M::Msg>>,
@@ -119,7 +117,6 @@ impl<M: Model> Part<M> {
             last: f64::NEG_INFINITY,
             error: None,
             received: 0,
-            batches: 0,
             chaos: chaos.map(|s| Pcg64Mcg::seed_from_u64(s ^ (u64::from(me) << 32))),
             batch: Vec::new(),
             sent: Vec::new(),
@@ -189,17 +186,8 @@ impl<M: Model> Part<M> {
             }
             let (time, to) = (first.time, first.to);
             self.batch.push(first.env);
-            while let Some(Item(p)) = self.pending.peek() {
-                if p.to != to || p.time != time {
-                    break;
-                }
-                let Some(p) = self.pop_live() else { break };
-                if p.to != to || p.time != time {
-                    self.pending.push(Item(p), false);
-                    break;
-                }
-                self.batch.push(p.env);
-            }
+            let (pending, cancelled) = (&mut self.pending, &mut self.cancelled);
+            take_rest_of_batch(pending, cancelled, &time, to, &mut self.batch);
             return Some((time, to));
         }
     }
@@ -216,7 +204,6 @@ impl<M: Model> Part<M> {
                     prefetch(&self.seqs[l]);
                 }
             }
-            self.batches += 1;
             self.stats.batches += 1;
             self.stats.delivered += self.batch.len() as u64;
             let mut ctx = Ctx::speculative(model, time.clone(), obj, &mut self.seqs[local]);
@@ -320,11 +307,11 @@ impl<M: Model> Part<M> {
                 self.pending.push(Item(p), false);
             }
             self.cancelled.extend(self.spare.cancels.drain(..));
-            self.sweep_cancelled();
         }
+        self.sweep_cancelled();
     }
 
-    /// Records a failure of the run in this worker's flags.
+    /// This worker's flags for its report: [`FAILED`] after a model bug.
     pub fn flags(&self) -> u64 {
         if self.error.is_some() {
             FAILED
