@@ -73,7 +73,7 @@ impl Checker {
             if err.is_some() || bj.pocket.is_some() {
                 return;
             }
-            let overlap = bi.radius + bj.radius - (bj.traj.at(t) - p).norm();
+            let overlap = bi.radius + bj.radius - table.separation(p, bj.traj.at(t)).norm();
             if overlap > slack(bi.radius.min(bj.radius), p) {
                 let (a, b) = (i.min(j), i.max(j));
                 err = Some(format!(
@@ -88,6 +88,7 @@ impl Checker {
             return Err(RunError::Violation(e));
         }
         let slack = slack(bi.radius, p);
+        // a ball in a periodic box is anywhere in the plane until it is taken back into the box
         let open_plane = table.cushions.is_empty() && table.pockets.is_empty();
         if !open_plane
             && (p.x < table.lo.x - slack
@@ -192,7 +193,7 @@ impl<'a> Snapshot<'a> {
     fn new(table: &'a Table, balls: &'a [BallState], t: f64) -> Snapshot<'a> {
         let mut by_x: Vec<(f64, u32)> = (0..balls.len() as u32)
             .filter(|&i| balls[i as usize].pocket.is_none())
-            .map(|i| (balls[i as usize].traj.at(t).x, i))
+            .map(|i| (Self::x(table, &balls[i as usize], t), i))
             .collect();
         by_x.sort_by(|a, b| a.0.total_cmp(&b.0));
         let reach = 2.0 * balls.iter().map(|b| b.radius).fold(0.0, f64::max);
@@ -203,6 +204,14 @@ impl<'a> Snapshot<'a> {
             reach,
             t,
         }
+    }
+}
+
+impl Snapshot<'_> {
+    /// The x of ball `b`'s centre at `t`, taken into the box if the table is periodic.
+    fn x(table: &Table, b: &BallState, t: f64) -> f64 {
+        let p = b.traj.at(t);
+        table.period.map_or(p, |period| period.wrap(p)).x
     }
 }
 
@@ -220,14 +229,22 @@ impl World for Snapshot<'_> {
     }
 
     fn for_each_neighbor(&self, i: u32, f: &mut dyn FnMut(u32)) {
-        let x = self.balls[i as usize].traj.at(self.t).x;
-        let from = self.by_x.partition_point(|e| e.0 < x - self.reach);
-        for &(xj, j) in &self.by_x[from..] {
-            if xj > x + self.reach {
-                break;
-            }
-            if j != i {
-                f(j);
+        let x = Self::x(self.table, &self.balls[i as usize], self.t);
+        // in a periodic box the neighbours near one side include those near the other
+        let sides = match &self.table.period {
+            Some(b) => vec![-b.size.x, 0.0, b.size.x],
+            None => vec![0.0],
+        };
+        for side in sides {
+            let x = x + side;
+            let from = self.by_x.partition_point(|e| e.0 < x - self.reach);
+            for &(xj, j) in &self.by_x[from..] {
+                if xj > x + self.reach {
+                    break;
+                }
+                if j != i {
+                    f(j);
+                }
             }
         }
     }

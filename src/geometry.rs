@@ -129,6 +129,64 @@ impl Trajectory {
     }
 }
 
+/// A rectangular periodic box: the plane folded onto a torus, so that a centre leaving through
+/// one side comes back through the opposite one. Wrapped positions lie in `[lo, lo + size)`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PeriodicBox {
+    /// The lower-left corner (length).
+    pub lo: Vec2,
+    /// The sides along x and y (length), both positive.
+    pub size: Vec2,
+}
+
+impl PeriodicBox {
+    /// The upper-right corner (length).
+    pub fn hi(&self) -> Vec2 {
+        self.lo + self.size
+    }
+
+    /// The whole numbers of sides, along x and y, that the separation `d` exceeds its minimum
+    /// image by (rounded to the nearest).
+    #[inline]
+    pub fn images(&self, d: Vec2) -> (f64, f64) {
+        ((d.x / self.size.x).round(), (d.y / self.size.y).round())
+    }
+
+    /// The translation by `m` sides along x and y.
+    #[inline]
+    pub fn shift(&self, m: (f64, f64)) -> Vec2 {
+        Vec2::new(m.0 * self.size.x, m.1 * self.size.y)
+    }
+
+    /// The minimum image of the separation `d`: the shortest of `d` moved by whole sides.
+    #[inline]
+    pub fn nearest(&self, d: Vec2) -> Vec2 {
+        d - self.shift(self.images(d))
+    }
+
+    /// The point `p` moved by whole sides into the box.
+    pub fn wrap(&self, p: Vec2) -> Vec2 {
+        let fold = |x: f64, lo: f64, l: f64| {
+            let w = lo + (x - lo).rem_euclid(l);
+            // rounding may land a point just below `lo` on `lo + l` itself
+            if w >= lo + l {
+                lo
+            } else {
+                w
+            }
+        };
+        Vec2::new(
+            fold(p.x, self.lo.x, self.size.x),
+            fold(p.y, self.lo.y, self.size.y),
+        )
+    }
+
+    /// Its area (length squared).
+    pub fn area(&self) -> f64 {
+        self.size.x * self.size.y
+    }
+}
+
 /// The squared distance from point `p` to the segment from `a` to `b`.
 pub fn segment_distance2(p: Vec2, a: Vec2, b: Vec2) -> f64 {
     let ab = b - a;

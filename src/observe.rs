@@ -250,7 +250,12 @@ impl Observer for Observables {
             EventKind::BallBall => {
                 let dp = self.kick(ev.a, world);
                 self.kick(ev.b, world);
-                let r = world.ball(ev.a).position(ev.t) - world.ball(ev.b).position(ev.t);
+                let (pa, pb) = (
+                    world.ball(ev.a).position(ev.t),
+                    world.ball(ev.b).position(ev.t),
+                );
+                // from b to a, the nearest image in a periodic box
+                let r = world.table().separation(pb, pa);
                 if counted {
                     self.block.virial += r.dot(dp);
                     self.block.collisions += 1;

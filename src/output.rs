@@ -2,6 +2,7 @@
 //! digest of the final state, and event counting. Formats are the contracts of DESIGN.md.
 
 use crate::engine::{BallState, Event, Observer, RunError, Table, World};
+use crate::geometry::PeriodicBox;
 use crate::scenario::{BallSpec, CushionSpec, Invalid, PocketSpec, Scenario};
 use serde::Serialize;
 use std::io::Write;
@@ -127,6 +128,9 @@ pub struct FinalState {
     pub cushions: Vec<CushionSpec>,
     /// The pockets, `Pocket-1` first.
     pub pockets: Vec<PocketSpec>,
+    /// The periodic box, where the boundary is periodic (the positions then lie in it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub periodic: Option<PeriodicBox>,
 }
 
 impl FinalState {
@@ -150,6 +154,7 @@ impl FinalState {
                 .collect(),
             cushions: s.cushions.clone(),
             pockets: s.pockets.clone(),
+            periodic: s.periodic,
         }
     }
 
@@ -192,6 +197,7 @@ impl FinalState {
             cushions: self.cushions.clone(),
             pockets: self.pockets.clone(),
             sectors: None,
+            periodic: self.periodic,
         })
     }
 }

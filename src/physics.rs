@@ -76,6 +76,22 @@ pub fn ball_ball_contact(a: &Trajectory, ra: f64, b: &Trajectory, rb: f64) -> Co
     approach(tref, dp, b.velocity - a.velocity, ra + rb)
 }
 
+/// [`ball_ball_contact`] of ball `a` with the image of ball `b` moved by `shift` (whole sides of
+/// a periodic box): the separation at the later fix is shifted once, so the time is a function
+/// of the two trajectories and the image alone.
+#[inline]
+pub fn ball_ball_contact_across(
+    a: &Trajectory,
+    ra: f64,
+    b: &Trajectory,
+    rb: f64,
+    shift: Vec2,
+) -> Contact {
+    let tref = a.t0.max(b.t0);
+    let dp = (b.at(tref) - a.at(tref)) + shift;
+    approach(tref, dp, b.velocity - a.velocity, ra + rb)
+}
+
 /// When a ball of radius `r` touches the fixed point `c`, a pocket's corner (thesis 3.1.4).
 #[inline]
 pub fn ball_corner_contact(ball: &Trajectory, r: f64, c: Vec2) -> Contact {

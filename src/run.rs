@@ -235,6 +235,12 @@ fn check_time_resolution(scenario: &Scenario, cfg: &RunConfig) -> Result<(), Run
 /// The engine `cfg` asks for, set up on `scenario` and ready to run: the one factory of engines
 /// (event list, time step, objects plain or sectored, sequential or under Time Warp).
 pub fn build_engine(scenario: &Scenario, cfg: &RunConfig) -> Result<Box<dyn Engine>, RunError> {
+    if scenario.periodic.is_some() && cfg.engine != EngineKind::EventList {
+        return Err(RunError::Input(format!(
+            "--engine {}: a periodic box runs on the event-list engine only",
+            cfg.engine.name()
+        )));
+    }
     Ok(match cfg.engine {
         EngineKind::EventList => {
             let opts = event_list::Options {
@@ -439,6 +445,7 @@ fn run_with_checkpoints(
                 cushions: scenario.cushions.clone(),
                 pockets: scenario.pockets.clone(),
                 sectors: scenario.sectors.clone(),
+                periodic: scenario.periodic,
             },
             events: EventTotals::from(&events),
             initial_energy,

@@ -104,6 +104,7 @@ impl Sample {
                 .collect(),
             pockets: Vec::new(),
             sectors: None,
+            periodic: None,
         }
     }
 }

@@ -46,6 +46,7 @@ fn scenario(name: &str, centres: &[Vec2], radius: f64, speed: f64, (w, h): (f64,
         ],
         pockets: Vec::new(),
         sectors: None,
+        periodic: None,
     }
 }
 

@@ -129,6 +129,9 @@ struct Layouts {
     rmax: f64,
     /// The number of balls the grid places.
     n: usize,
+    /// Whether the table is a periodic box: cells then tile it exactly, at least three along
+    /// each side, and wrap around at its sides.
+    periodic: bool,
 }
 
 impl Layouts {
@@ -138,14 +141,18 @@ impl Layouts {
         let span = table.hi - table.lo;
         let w_min = (2.0 * rmax * CELL_MARGIN).max(min_cell);
         let most = (4 * n).max(16) as f64;
+        let periodic = table.period.is_some();
+        // a periodic box keeps three cells along a side even where `min_cell` asks for fewer
+        // (its validation makes sure that three are each a diameter wide)
+        let fewest = if periodic { 3.0 } else { 1.0 };
         let (mut nx, mut ny) = (
-            (span.x / w_min).floor().clamp(1.0, MAX_SIDE),
-            (span.y / w_min).floor().clamp(1.0, MAX_SIDE),
+            (span.x / w_min).floor().clamp(fewest, MAX_SIDE),
+            (span.y / w_min).floor().clamp(fewest, MAX_SIDE),
         );
         let mut dims = vec![(nx as u32, ny as u32)];
         while nx * ny > most {
-            nx = (nx / 2.0).floor().max(1.0);
-            ny = (ny / 2.0).floor().max(1.0);
+            nx = (nx / 2.0).floor().max(fewest);
+            ny = (ny / 2.0).floor().max(fewest);
             dims.push((nx as u32, ny as u32));
         }
         Layouts {
@@ -154,6 +161,7 @@ impl Layouts {
             w_min,
             rmax,
             n,
+            periodic,
         }
     }
 
@@ -217,7 +225,9 @@ impl Grid {
     /// An empty grid in `layouts`' layout number `level`.
     fn laid_out(table: &Table, layouts: Layouts, level: usize) -> Grid {
         let (nx, ny) = layouts.dims[level];
-        let hashed = level + 1 < layouts.dims.len();
+        // a periodic box takes the dense form at every level: its cells wrap around by
+        // arithmetic on their coordinates
+        let hashed = level + 1 < layouts.dims.len() && !layouts.periodic;
         let span = table.hi - table.lo;
         let cells = if hashed { 0 } else { (nx * ny) as usize };
         let mut g = Grid {
@@ -232,7 +242,7 @@ impl Grid {
             fixed_span: Vec::with_capacity(cells),
             fixed_items: Vec::new(),
             has_fixed: vec![0; cells.div_ceil(64)],
-            general: hashed,
+            general: hashed || layouts.periodic,
             hashed: None,
             spill: FxHashMap::default(),
             crowded: false,
@@ -586,12 +596,15 @@ impl Grid {
             }
             None if c < self.nx * self.ny => {
                 let (cx, cy) = (i64::from(c % self.nx), i64::from(c / self.nx));
+                let (nx, ny) = (i64::from(self.nx), i64::from(self.ny));
                 out[0] = c;
                 for (k, &(dx, dy)) in AROUND.iter().enumerate() {
-                    let (x, y) = (cx + i64::from(dx), cy + i64::from(dy));
-                    if (0..i64::from(self.nx)).contains(&x) && (0..i64::from(self.ny)).contains(&y)
-                    {
-                        out[k + 1] = (y * i64::from(self.nx) + x) as u32;
+                    let (mut x, mut y) = (cx + i64::from(dx), cy + i64::from(dy));
+                    if self.layouts.periodic {
+                        (x, y) = (x.rem_euclid(nx), y.rem_euclid(ny));
+                    }
+                    if (0..nx).contains(&x) && (0..ny).contains(&y) {
+                        out[k + 1] = (y * nx + x) as u32;
                     }
                 }
             }
@@ -660,6 +673,10 @@ impl Grid {
     /// [`Grid::for_each_entering`] through the cell ids and their coordinates.
     #[inline(never)]
     fn for_each_entering_block(&self, from: u32, to: u32, f: &mut impl FnMut(u32)) {
+        if self.layouts.periodic {
+            self.for_each_entering_image(from, to, |j, _| f(j));
+            return;
+        }
         let (fx, fy) = self.coords(from);
         let (tx, ty) = self.coords(to);
         let step = (i64::from(tx) - i64::from(fx), i64::from(ty) - i64::from(fy));
@@ -682,6 +699,56 @@ impl Grid {
                 self.for_each_in(n, f);
             }
         }
+    }
+
+    /// In a periodic box: calls `f` with every ball in the 3 × 3 block of cells around cell `c`
+    /// (including `c`), and with the offset of its cell from `c` in cells (each of `-1, 0, 1`
+    /// along x and y): which image of the ball is the neighbour.
+    pub fn for_each_near_image(&self, c: u32, mut f: impl FnMut(u32, (i32, i32))) {
+        let block = self.block(c);
+        for (&n, offset) in block.iter().zip([(0, 0)].into_iter().chain(AROUND)) {
+            if n != NIL {
+                self.for_each_in(n, &mut |j| f(j, offset));
+            }
+        }
+    }
+
+    /// In a periodic box: calls `f` with every ball in the cells of the 3 × 3 block around `to`
+    /// that are not in the block around `from` (a neighbouring cell, which a centre left for
+    /// `to`), and with the offset of its cell from `to`. With three cells along a side one cell
+    /// may be in both blocks as two different images: it is new as the image it is around `to`.
+    pub fn for_each_entering_image(&self, from: u32, to: u32, mut f: impl FnMut(u32, (i32, i32))) {
+        let (fx, fy) = self.coords(from);
+        let (tx, ty) = self.coords(to);
+        // the step from `from` to `to`, each of -1, 0, 1 whichever side of the box it crossed
+        let step = |t: u32, f: u32, n: u32| -> i32 {
+            match (i64::from(t) - i64::from(f)).rem_euclid(i64::from(n)) {
+                0 => 0,
+                1 => 1,
+                _ => -1,
+            }
+        };
+        let (sx, sy) = (step(tx, fx, self.nx), step(ty, fy, self.ny));
+        let block = self.block(to);
+        for (&n, (dx, dy)) in block.iter().zip([(0, 0)].into_iter().chain(AROUND)) {
+            if n != NIL && ((dx + sx).abs() > 1 || (dy + sy).abs() > 1) {
+                self.for_each_in(n, &mut |j| f(j, (dx, dy)));
+            }
+        }
+    }
+
+    /// The size of a cell along x and y.
+    pub fn cell_size(&self) -> Vec2 {
+        Vec2::new(self.width, self.height)
+    }
+
+    /// The centre of cell `c` of the dense layout.
+    pub fn cell_centre(&self, c: u32) -> Vec2 {
+        let (cx, cy) = self.coords(c);
+        Vec2::new(
+            self.lo.x + (f64::from(cx) + 0.5) * self.width,
+            self.lo.y + (f64::from(cy) + 0.5) * self.height,
+        )
     }
 
     /// The fixed objects a ball whose centre is in cell `c` may touch before it leaves the cell.
@@ -737,19 +804,21 @@ impl Grid {
         t0: f64,
     ) -> Option<(f64, u32)> {
         let (cx, cy) = self.coords(c);
+        // a periodic box's outer cells are left through the box's sides too
+        let wraps = self.layouts.periodic;
         // the time, and the neighbour entered as its place in `AROUND`
         let mut best: Option<(f64, usize)> = None;
-        if velocity.x > 0.0 && cx + 1 < self.nx {
+        if velocity.x > 0.0 && (wraps || cx + 1 < self.nx) {
             let b = self.lo.x + f64::from(cx + 1) * self.width;
             best = Some((t0 + (b - position.x) / velocity.x, 4));
-        } else if velocity.x < 0.0 && cx > 0 {
+        } else if velocity.x < 0.0 && (wraps || cx > 0) {
             let b = self.lo.x + f64::from(cx) * self.width;
             best = Some((t0 + (b - position.x) / velocity.x, 3));
         }
-        let y = if velocity.y > 0.0 && cy + 1 < self.ny {
+        let y = if velocity.y > 0.0 && (wraps || cy + 1 < self.ny) {
             let b = self.lo.y + f64::from(cy + 1) * self.height;
             Some((t0 + (b - position.y) / velocity.y, 6))
-        } else if velocity.y < 0.0 && cy > 0 {
+        } else if velocity.y < 0.0 && (wraps || cy > 0) {
             let b = self.lo.y + f64::from(cy) * self.height;
             Some((t0 + (b - position.y) / velocity.y, 1))
         } else {
@@ -760,7 +829,11 @@ impl Grid {
             (a, b) => a.or(b),
         }?;
         let (dx, dy) = AROUND[k];
-        let (x, y) = (cx.wrapping_add_signed(dx), cy.wrapping_add_signed(dy));
+        let (mut x, mut y) = (cx.wrapping_add_signed(dx), cy.wrapping_add_signed(dy));
+        if wraps {
+            x = (i64::from(cx) + i64::from(dx)).rem_euclid(i64::from(self.nx)) as u32;
+            y = (i64::from(cy) + i64::from(dy)).rem_euclid(i64::from(self.ny)) as u32;
+        }
         let to = match &self.hashed {
             None => y * self.nx + x,
             Some(h) if h.around[c as usize][k] != NIL => h.around[c as usize][k],
@@ -921,6 +994,7 @@ mod tests {
             ],
             pockets: Vec::new(),
             sectors: None,
+            periodic: None,
         })
     }
 

@@ -13,7 +13,7 @@ pub mod partition;
 pub mod time_step;
 
 use crate::checkpoint::Checkpoint;
-use crate::geometry::{Trajectory, Vec2};
+use crate::geometry::{PeriodicBox, Trajectory, Vec2};
 use crate::physics::{self, Contact};
 use crate::scenario::Scenario;
 use pdes_kernel::Interrupt;
@@ -94,6 +94,8 @@ pub struct Table {
     pub lo: Vec2,
     /// Upper-right corner of the table's bounding box.
     pub hi: Vec2,
+    /// The periodic box, where the boundary is periodic (`lo` and `hi` are then its corners).
+    pub period: Option<PeriodicBox>,
 }
 
 impl Table {
@@ -113,6 +115,16 @@ impl Table {
                 .collect(),
             lo,
             hi,
+            period: s.periodic,
+        }
+    }
+
+    /// The separation from `p` to `q`: `q - p`, or its nearest image in a periodic box.
+    #[inline]
+    pub fn separation(&self, p: Vec2, q: Vec2) -> Vec2 {
+        match &self.period {
+            Some(b) => b.nearest(q - p),
+            None => q - p,
         }
     }
 

@@ -45,6 +45,18 @@ pub struct Params {
     pub temperature: Option<f64>,
     /// `--mixture F:Q`: a fraction `F` of the balls large, their diameter `Q` times the others'.
     pub mixture: Option<Mixture>,
+    /// `--boundary walled|periodic`: cushions around the box (the default) or a periodic box.
+    pub boundary: Option<Boundary>,
+}
+
+/// What bounds a generated box.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Boundary {
+    /// Four elastic cushions.
+    #[default]
+    Walled,
+    /// None: the box is periodic (a torus).
+    Periodic,
 }
 
 /// The sites of a lattice start.
@@ -78,6 +90,7 @@ const SPEED: &str = "--speed-max";
 pub(super) const LATTICE: &str = "--lattice";
 pub(super) const TEMPERATURE: &str = "--temperature";
 pub(super) const MIXTURE: &str = "--mixture";
+pub(super) const BOUNDARY: &str = "--boundary";
 
 pub(super) const DEFAULT_SEED: u64 = 1;
 
@@ -126,7 +139,8 @@ const BUILTINS: [Builtin; 7] = [
             format!(
                 "thesis ch. 6 hard-disk gas: k x k balls with random velocities on a square table \
                  ({BALLS} {GAS_BALLS}, {RADIUS} {GAS_RADIUS}, {SPEED} {GAS_SPEED}, {SEED} \
-                 {DEFAULT_SEED}; side {GAS_SPACING} k, or set by {AREA}); until {GAS_UNTIL}"
+                 {DEFAULT_SEED}; side {GAS_SPACING} k, or set by {AREA}; {BOUNDARY} walled or \
+                 periodic); until {GAS_UNTIL}"
             )
         },
         build: gas,
@@ -228,6 +242,7 @@ pub(super) fn allow(p: &Params, name: &str, takes: &[&str]) -> Result<(), Invali
         (LATTICE, p.lattice.is_some()),
         (TEMPERATURE, p.temperature.is_some()),
         (MIXTURE, p.mixture.is_some()),
+        (BOUNDARY, p.boundary.is_some()),
     ];
     for (flag, set) in given {
         if set && !takes.contains(&flag) {
@@ -283,11 +298,16 @@ fn random_velocity(rng: &mut ChaCha8Rng, vmax: f64) -> Vec2 {
 /// Four cushions of elasticity 1 around the rectangle `[0, w] × [0, h]`, clockwise from the
 /// left side.
 pub(super) fn box_cushions(w: f64, h: f64) -> Vec<CushionSpec> {
+    box_cushions_at(Vec2::ZERO, Vec2::new(w, h))
+}
+
+/// Four elastic cushions, clockwise, around the rectangle from `lo` of sides `size`.
+pub(super) fn box_cushions_at(lo: Vec2, size: Vec2) -> Vec<CushionSpec> {
     let corners = [
-        Vec2::new(0.0, 0.0),
-        Vec2::new(0.0, h),
-        Vec2::new(w, h),
-        Vec2::new(w, 0.0),
+        lo,
+        Vec2::new(lo.x, lo.y + size.y),
+        lo + size,
+        Vec2::new(lo.x + size.x, lo.y),
     ];
     (0..4)
         .map(|i| cushion(corners[i], corners[(i + 1) % 4]))
@@ -345,6 +365,7 @@ fn plate1(p: &Params) -> Result<Scenario, Invalid> {
         ],
         pockets: vec![pocket(v(270.0, 400.0), v(330.0, 400.0))],
         sectors: None,
+        periodic: None,
     })
 }
 
@@ -424,7 +445,7 @@ fn lattice(n: usize, k: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
 /// The side is `100 k` (the thesis' 600 × 600 for 36 balls) or, with `--area-fraction PHI`,
 /// `sqrt(N π r² / PHI)`. Velocities are drawn ball by ball in ball order.
 fn gas(p: &Params) -> Result<Scenario, Invalid> {
-    allow(p, "gas", &[BALLS, SEED, AREA, RADIUS, SPEED])?;
+    allow(p, "gas", &[BALLS, SEED, AREA, RADIUS, SPEED, BOUNDARY])?;
     let n = p.balls.unwrap_or(GAS_BALLS);
     if n == 0 || n > MAX_BALLS {
         return Err(bad(
@@ -490,14 +511,33 @@ fn gas(p: &Params) -> Result<Scenario, Invalid> {
         .into_iter()
         .map(|position| BallSpec::moving(position, random_velocity(&mut rng, vmax), r, 1.0))
         .collect();
-    Ok(Scenario {
-        name: "gas".into(),
-        until: GAS_UNTIL,
-        balls,
-        cushions: box_cushions(side, side),
-        pockets: Vec::new(),
-        sectors: None,
-    })
+    Ok(boxed(
+        Scenario {
+            name: "gas".into(),
+            until: GAS_UNTIL,
+            balls,
+            cushions: Vec::new(),
+            pockets: Vec::new(),
+            sectors: None,
+            periodic: None,
+        },
+        side,
+        p.boundary.unwrap_or_default(),
+    ))
+}
+
+/// `s` in the square box `[0, side]²`, walled by four elastic cushions or periodic.
+pub(super) fn boxed(mut s: Scenario, side: f64, boundary: Boundary) -> Scenario {
+    match boundary {
+        Boundary::Walled => s.cushions = box_cushions(side, side),
+        Boundary::Periodic => {
+            s.periodic = Some(crate::geometry::PeriodicBox {
+                lo: Vec2::ZERO,
+                size: Vec2::new(side, side),
+            })
+        }
+    }
+    s
 }
 
 /// The reversal test of thesis 4.6–4.7: a 4 × 4 array of balls (centres 50, 150, 250, 350 on a
@@ -521,6 +561,7 @@ fn reversal(p: &Params) -> Result<Scenario, Invalid> {
         cushions: box_cushions(REVERSAL_SIDE, REVERSAL_SIDE),
         pockets: Vec::new(),
         sectors: None,
+        periodic: None,
     })
 }
 
@@ -593,6 +634,7 @@ fn pool(p: &Params) -> Result<Scenario, Invalid> {
         cushions,
         pockets,
         sectors: None,
+        periodic: None,
     })
 }
 
@@ -612,6 +654,7 @@ fn cradle(p: &Params) -> Result<Scenario, Invalid> {
         cushions: box_cushions(1000.0, 200.0),
         pockets: Vec::new(),
         sectors: None,
+        periodic: None,
     })
 }
 
@@ -671,6 +714,7 @@ fn implosion(p: &Params) -> Result<Scenario, Invalid> {
         cushions: box_cushions(side, side),
         pockets: Vec::new(),
         sectors: None,
+        periodic: None,
     })
 }
 

@@ -8,8 +8,8 @@
 //! measuring (`--observe-from`), or start a new run from its final state.
 
 use super::builtin::{
-    allow, bad, box_cushions, radius_param, triangular_rows, Lattice, Mixture, Params, AREA, BALLS,
-    DEFAULT_SEED, GAP, LATTICE, MIXTURE, RADIUS, SEED, TEMPERATURE,
+    allow, bad, boxed, radius_param, triangular_rows, Boundary, Lattice, Mixture, Params, AREA,
+    BALLS, BOUNDARY, DEFAULT_SEED, GAP, LATTICE, MIXTURE, RADIUS, SEED, TEMPERATURE,
 };
 use super::{BallSpec, Invalid, Scenario};
 use crate::geometry::Vec2;
@@ -28,10 +28,10 @@ const DISKS_UNTIL: f64 = 10.0;
 pub fn describe() -> String {
     format!(
         "a hard-disk fluid's start: {BALLS} {DISKS_BALLS} disks ({RADIUS} {DISKS_RADIUS}, mass 1) \
-         on a {LATTICE} triangular|square lattice in a square box of elastic cushions at \
-         {AREA} {DISKS_AREA}, Maxwell-Boltzmann velocities at {TEMPERATURE} {DISKS_TEMPERATURE} \
-         with zero total momentum, {MIXTURE} F:Q for a fraction F of large disks Q times as \
-         wide ({SEED} {DEFAULT_SEED}); until {DISKS_UNTIL}"
+         on a {LATTICE} triangular|square lattice in a square box ({BOUNDARY} walled by elastic \
+         cushions, or periodic) at {AREA} {DISKS_AREA}, Maxwell-Boltzmann velocities at \
+         {TEMPERATURE} {DISKS_TEMPERATURE} with zero total momentum, {MIXTURE} F:Q for a \
+         fraction F of large disks Q times as wide ({SEED} {DEFAULT_SEED}); until {DISKS_UNTIL}"
     )
 }
 
@@ -40,7 +40,16 @@ pub fn disks(p: &Params) -> Result<Scenario, Invalid> {
     allow(
         p,
         "disks",
-        &[BALLS, SEED, AREA, RADIUS, LATTICE, TEMPERATURE, MIXTURE],
+        &[
+            BALLS,
+            SEED,
+            AREA,
+            RADIUS,
+            LATTICE,
+            TEMPERATURE,
+            MIXTURE,
+            BOUNDARY,
+        ],
     )?;
     let n = p.balls.unwrap_or(DISKS_BALLS);
     if !(2..=super::builtin::MAX_BALLS).contains(&n) {
@@ -72,15 +81,24 @@ pub fn disks(p: &Params) -> Result<Scenario, Invalid> {
     let side = (covered / phi).sqrt();
     let rmax = radii.iter().copied().fold(0.0, f64::max);
     let lattice = p.lattice.unwrap_or(Lattice::Triangular);
-    let sites = sites(lattice, n, rmax, side).map_err(|need| {
+    let boundary = p.boundary.unwrap_or_default();
+    let sites = match boundary {
+        Boundary::Walled => sites(lattice, n, rmax, side),
+        Boundary::Periodic => periodic_sites(lattice, n, rmax, side),
+    };
+    let sites = sites.map_err(|need| {
         let most = (covered / (need * need) * 1e6).floor() / 1e6;
         bad(
             AREA,
             format!(
-                "{phi} is too dense for {n} disks on a {} lattice in a walled box: at most {most}",
+                "{phi} is too dense for {n} disks on a {} lattice in a {} box: at most {most}",
                 match lattice {
                     Lattice::Square => "square",
                     Lattice::Triangular => "triangular",
+                },
+                match boundary {
+                    Boundary::Walled => "walled",
+                    Boundary::Periodic => "periodic",
                 }
             ),
         )
@@ -92,14 +110,16 @@ pub fn disks(p: &Params) -> Result<Scenario, Invalid> {
         .zip(velocities)
         .map(|((position, radius), velocity)| BallSpec::moving(position, velocity, radius, 1.0))
         .collect();
-    Ok(Scenario {
+    let s = Scenario {
         name: "disks".into(),
         until: DISKS_UNTIL,
         balls,
-        cushions: box_cushions(side, side),
+        cushions: Vec::new(),
         pockets: Vec::new(),
         sectors: None,
-    })
+        periodic: None,
+    };
+    Ok(boxed(s, side, boundary))
 }
 
 /// Every disk's radius: the small radius, and for a mixture the large one on a random choice
@@ -156,6 +176,51 @@ fn sites(lattice: Lattice, n: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64
         })
         .collect();
     Ok(pts)
+}
+
+/// Sites for `n` disks of radius at most `r` in the periodic box `[0, side)²`: the first `n` of
+/// a lattice that tiles the box, `m` columns by `k` rows (for the triangular lattice `k` even
+/// and every other row shifted by half a column, the shape nearest the regular lattice). `Err`
+/// holds the smallest side that would take them.
+fn periodic_sites(lattice: Lattice, n: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
+    let d = 2.0 * r * (1.0 + GAP);
+    // the closest two sites, in box sides, of `m` columns by `k` rows
+    let closest = |m: usize, k: usize| -> f64 {
+        let (ax, ay) = (1.0 / m as f64, 1.0 / k as f64);
+        match lattice {
+            Lattice::Square => ax.min(ay),
+            Lattice::Triangular => ax.min((0.25 * ax * ax + ay * ay).sqrt()).min(2.0 * ay),
+        }
+    };
+    let rows = |m: usize| match lattice {
+        Lattice::Square => n.div_ceil(m),
+        Lattice::Triangular => n.div_ceil(m).next_multiple_of(2),
+    };
+    let root = (n as f64).sqrt().ceil() as usize;
+    let (m, k) = match lattice {
+        Lattice::Square => (root, root),
+        Lattice::Triangular => (root / 2..=2 * root + 2)
+            .filter(|&m| m >= 1)
+            .map(|m| (m, rows(m)))
+            .max_by(|a, b| closest(a.0, a.1).total_cmp(&closest(b.0, b.1)))
+            .expect("a range of columns"),
+    };
+    let spacing = closest(m, k) * side;
+    if spacing < d {
+        return Err(side * d / spacing);
+    }
+    let shift = match lattice {
+        Lattice::Square => 0.0,
+        Lattice::Triangular => 0.5,
+    };
+    let (ax, ay) = (side / m as f64, side / k as f64);
+    Ok((0..n)
+        .map(|s| {
+            let (j, i) = (s / m, s % m);
+            let offset = if j % 2 == 1 { shift } else { 0.0 };
+            Vec2::new((i as f64 + 0.25 + offset) * ax, (j as f64 + 0.5) * ay)
+        })
+        .collect())
 }
 
 /// Velocities of `n` unit masses from the Maxwell-Boltzmann distribution at `kt`: normal

@@ -7,9 +7,12 @@
 
 pub mod builtin;
 mod disks;
+mod periodic;
 pub mod toml;
 
-use crate::geometry::{Trajectory, Vec2};
+pub use periodic::MIN_SIDE_DIAMETERS;
+
+use crate::geometry::{PeriodicBox, Trajectory, Vec2};
 use crate::vtime::Key;
 use std::fmt;
 
@@ -147,6 +150,10 @@ pub struct Scenario {
     pub pockets: Vec<PocketSpec>,
     /// Optional sector layout.
     pub sectors: Option<SectorSpec>,
+    /// The periodic box, where the boundary is periodic (no cushions or pockets then); `None`:
+    /// the table is walled by its cushions, or open.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub periodic: Option<PeriodicBox>,
 }
 
 /// What is wrong with a scenario: one line naming the place and the field.
@@ -285,9 +292,12 @@ impl Scenario {
         }
     }
 
-    /// The lower-left and upper-right corners of the box around every cushion and pocket end,
-    /// or around the balls when the table has no sides.
+    /// The lower-left and upper-right corners of the periodic box, or of the box around every
+    /// cushion and pocket end, or around the balls when the table has no sides.
     pub fn bounds(&self) -> (Vec2, Vec2) {
+        if let Some(b) = &self.periodic {
+            return (b.lo, b.hi());
+        }
         let mut pts: Vec<Vec2> = self
             .cushions
             .iter()
@@ -321,6 +331,9 @@ impl Scenario {
     /// Overlap is found with a sort along x, so validation of a million balls stays fast.
     pub fn validate(&self) -> Result<(), Invalid> {
         self.check_balls_and_table()?;
+        if self.periodic.is_some() {
+            return self.check_periodic();
+        }
         self.check_on_table()?;
         self.check_overlaps()?;
         self.check_sectors()

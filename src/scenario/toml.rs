@@ -18,7 +18,14 @@
 //! elasticity = 1.0          # optional, default 1: the elasticity of the two corners
 //! [sectors]                 # optional: grid = [nx, ny] or [[sectors.polygon]] points = [...]
 //! grid = [3, 3]
+//! [box]                     # optional, in place of cushions and pockets: a rectangle
+//! size = [40.0, 30.0]
+//! origin = [0.0, 0.0]       # optional, default [0, 0]: the lower-left corner
+//! boundary = "periodic"     # "periodic" (a torus) or "walled" (four elastic cushions)
 //! ```
+//!
+//! In a periodic box a ball's position is taken into the box by whole sides (so a crystal
+//! may be written unwrapped).
 //!
 //! Every error is one line, `file:line: field: message`: serde reports unknown keys, missing keys
 //! and wrong types with a byte span that we turn into a line, and [`Scenario::validate`] reports
@@ -26,7 +33,7 @@
 //! Nothing here panics, whatever the input.
 
 use super::{BallSpec, CushionSpec, Invalid, PocketSpec, Scenario, ScenarioError, SectorSpec};
-use crate::geometry::Vec2;
+use crate::geometry::{PeriodicBox, Vec2};
 use ::toml::Spanned;
 use serde::de::{self, IgnoredAny, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
@@ -171,6 +178,16 @@ struct RawFile {
     #[serde(default)]
     pocket: Vec<Spanned<RawPocket>>,
     sectors: Option<RawSectors>,
+    #[serde(rename = "box")]
+    rect: Option<RawBox>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBox {
+    size: Spanned<Pair<f64>>,
+    origin: Option<Spanned<Pair<f64>>>,
+    boundary: Option<Spanned<String>>,
 }
 
 #[derive(Deserialize)]
@@ -365,7 +382,7 @@ impl RawFile {
                 }
             }),
         };
-        Ok(Scenario {
+        let mut scenario = Scenario {
             name: source.to_string(),
             until: self
                 .run
@@ -375,7 +392,12 @@ impl RawFile {
             cushions,
             pockets,
             sectors,
-        })
+            periodic: None,
+        };
+        if let Some(rect) = &self.rect {
+            rect.apply(&mut scenario)?;
+        }
+        Ok(scenario)
     }
 
     /// The span of a field named the way [`Scenario::validate`] names it (`ball[3].radius`,
@@ -429,6 +451,8 @@ impl RawFile {
         }
         match (head, rest) {
             ("run", Some("until")) => self.run.as_ref()?.until.as_ref().map(span),
+            ("box", Some("origin")) => self.rect.as_ref()?.origin.as_ref().map(span),
+            ("box", _) => Some(span(&self.rect.as_ref()?.size)),
             ("sectors", Some(rest)) => {
                 let sectors = self.sectors.as_ref()?;
                 if rest == "grid" {
@@ -450,6 +474,66 @@ impl RawFile {
             }
             _ => None,
         }
+    }
+}
+
+impl RawBox {
+    /// Gives `s` this box: a periodic boundary (every ball taken into the box), or four elastic
+    /// cushions around it. Refused beside cushions or pockets of the file's own.
+    fn apply(&self, s: &mut Scenario) -> Result<(), (Invalid, Option<Range<usize>>)> {
+        let lo = self
+            .origin
+            .as_ref()
+            .map_or(Vec2::ZERO, |o| o.get_ref().vec());
+        let size = self.size.get_ref().vec();
+        let refuse = |message: String, at: Range<usize>| {
+            Err((
+                Invalid {
+                    field: "box".into(),
+                    message,
+                },
+                Some(at),
+            ))
+        };
+        if !s.cushions.is_empty() || !s.pockets.is_empty() {
+            return refuse(
+                "a box brings its own boundary: give either [box] or cushions and pockets".into(),
+                span(&self.size),
+            );
+        }
+        let periodic = match self
+            .boundary
+            .as_ref()
+            .map(|b| (b.get_ref().as_str(), b.span()))
+        {
+            None | Some(("walled", _)) => false,
+            Some(("periodic", _)) => true,
+            Some((other, at)) => {
+                return refuse(
+                    format!("boundary must be \"periodic\" or \"walled\", got {other:?}"),
+                    at,
+                )
+            }
+        };
+        if !(lo.is_finite() && size.is_finite() && size.x > 0.0 && size.y > 0.0) {
+            return refuse(
+                format!(
+                    "size must be two positive numbers and origin finite, got size [{}, {}]",
+                    size.x, size.y
+                ),
+                span(&self.size),
+            );
+        }
+        if periodic {
+            let b = PeriodicBox { lo, size };
+            for ball in &mut s.balls {
+                ball.position = b.wrap(ball.position);
+            }
+            s.periodic = Some(b);
+        } else {
+            s.cushions = super::builtin::box_cushions_at(lo, size);
+        }
+        Ok(())
     }
 }
 

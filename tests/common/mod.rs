@@ -121,6 +121,7 @@ pub fn random_scenario() -> impl Strategy<Value = Scenario> {
                 cushions,
                 pockets,
                 sectors: None,
+                periodic: None,
             }
         })
 }

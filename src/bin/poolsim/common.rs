@@ -35,6 +35,18 @@ pub struct GenArgs {
     /// A binary mixture F:Q: a fraction F of the disks large, Q times as wide (disks).
     #[arg(long, value_parser = parse_mixture)]
     pub mixture: Option<builtin::Mixture>,
+    /// What bounds the box: walled (elastic cushions, the default) or periodic (gas, disks).
+    #[arg(long, value_enum)]
+    pub boundary: Option<BoundaryArg>,
+}
+
+/// `--boundary`: what bounds a generated box.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BoundaryArg {
+    /// Four elastic cushions.
+    Walled,
+    /// No walls: a ball leaving through one side comes back through the opposite one.
+    Periodic,
 }
 
 /// `--lattice`: the sites a start's disks stand on.
@@ -76,6 +88,10 @@ impl GenArgs {
             }),
             temperature: self.temperature,
             mixture: self.mixture,
+            boundary: self.boundary.map(|b| match b {
+                BoundaryArg::Walled => builtin::Boundary::Walled,
+                BoundaryArg::Periodic => builtin::Boundary::Periodic,
+            }),
         }
     }
 }

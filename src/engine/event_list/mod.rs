@@ -17,6 +17,8 @@
 //! ball's place in the calendar); neighbours are gathered and prefetched before the pair tests,
 //! and a ball's records are prefetched when its calendar bucket opens, a few events ahead.
 //!
+//! A periodic box (the `periodic` submodule) folds the same grid onto a torus.
+//!
 //! Why one event per ball is enough: for any pair whose next contact is at key `X`, the ball of
 //! the pair that last recomputed its events did so with both current trajectories and kept an
 //! event no later than `X`; if that event is popped stale, the ball recomputes and keeps one no
@@ -28,7 +30,7 @@ use super::{
     BallState, Event, EventCounts, EventKind, Fixed, Frame, InstantCap, Observer, Outcome,
     RunError, Span, Table, World,
 };
-use crate::geometry::{Trajectory, Vec2};
+use crate::geometry::{PeriodicBox, Trajectory, Vec2};
 use crate::physics::{self, Contact};
 use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
@@ -36,6 +38,8 @@ use pdes_kernel::prefetch::{prefetch, prefetch_all};
 use pdes_kernel::Interrupt;
 use smallvec::SmallVec;
 use std::cmp::Ordering;
+
+mod periodic;
 
 /// The pair code that marks a ball leaving its cell: sorts after every physical event of its
 /// instant (a crossing changes no trajectory, so its place within the instant does not matter).
@@ -90,6 +94,10 @@ const NOT_ON_TABLE: u32 = u32::MAX;
 
 /// The balls in the 3 × 3 cells around a ball.
 type Near = SmallVec<[u32; 48]>;
+
+/// In a periodic box, the translation (whole sides) that brings each of [`Near`]'s balls to its
+/// image next to the ball; empty in a walled box.
+type Shifts = SmallVec<[Vec2; 48]>;
 
 /// The rest of a ball's state, read only when the ball itself is handled (never by a neighbour's
 /// prediction): two cache lines, so handling a ball costs few trips to memory.
@@ -206,6 +214,11 @@ pub struct EventList {
     interrupt: Option<Interrupt>,
     /// Cell crossings still to come before the grid's layout is looked at again.
     look_in: u64,
+    /// The periodic box, if the table is one.
+    period: Option<PeriodicBox>,
+    /// In a periodic box, the whole sides along x and y to add to each ball's trajectory for its
+    /// unwrapped position (how far it has travelled across the box); empty in a walled box.
+    unwrap: Vec<(f64, f64)>,
 }
 
 /// Options of the event-list engine.
@@ -230,11 +243,13 @@ impl EventList {
     /// Sets up the engine at time 0 for a validated scenario and predicts every ball's first event.
     pub fn new(s: &Scenario, opts: Options) -> EventList {
         let table = Table::new(s);
+        let period = table.period;
         let start = opts.span.start;
         let balls = BallState::initial(s, start);
         let n = balls.len();
         let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let centres: Vec<_> = balls.iter().map(|b| b.position(start)).collect();
+        let wrap = |p: Vec2| period.map_or(p, |b| b.wrap(p));
+        let centres: Vec<_> = balls.iter().map(|b| wrap(b.position(start))).collect();
         let mut grid = Grid::new(
             &table,
             &centres,
@@ -248,7 +263,7 @@ impl EventList {
                 // a ball in a pocket (taken up from a checkpoint) is in no cell
                 let cell = match b.pocket {
                     Some(_) => NOT_ON_TABLE,
-                    None => grid.insert_at(i as u32, b.traj.at(start)),
+                    None => grid.insert_at(i as u32, centres[i]),
                 };
                 Slot {
                     traj: b.traj,
@@ -286,6 +301,12 @@ impl EventList {
             interrupt: None,
             instant: InstantCap::new(n),
             look_in: 0,
+            period,
+            unwrap: if period.is_some() {
+                vec![(0.0, 0.0); n]
+            } else {
+                Vec::new()
+            },
         };
         e.look_in = e.look_interval();
         // First predictions go into a provisional calendar; the real one's bucket width comes
@@ -312,6 +333,11 @@ impl EventList {
     /// The table.
     pub fn table(&self) -> &Table {
         &self.table
+    }
+
+    /// The grid's cells along x and y in its present layout.
+    pub fn grid_dims(&self) -> (u32, u32) {
+        self.grid.dims()
     }
 
     /// The engine's counters so far.
@@ -347,13 +373,32 @@ impl EventList {
         } else {
             physics::ball_ball_contact(&o.traj, o.radius, &b.traj, b.radius)
         };
+        self.offer_contact(i, j, o.counter, contact, best);
+    }
+
+    /// Offers the contact of ball `i` (slot `b`) with the image of ball `j` that `shift` moves
+    /// next to it, in a periodic box, to `best`.
+    #[inline]
+    fn offer_image(&self, i: u32, b: &Slot, j: u32, shift: Vec2, best: &mut Best) {
+        let o = &self.slots[j as usize];
+        let contact = if i < j {
+            physics::ball_ball_contact_across(&b.traj, b.radius, &o.traj, o.radius, shift)
+        } else {
+            physics::ball_ball_contact_across(&o.traj, o.radius, &b.traj, b.radius, -shift)
+        };
+        self.offer_contact(i, j, o.counter, contact, best);
+    }
+
+    /// Offers `contact`, of ball `i` with ball `j` whose counter is `counter`, to `best`.
+    #[inline(always)]
+    fn offer_contact(&self, i: u32, j: u32, counter: u32, contact: Contact, best: &mut Best) {
         let p = pair(i, j);
         match contact {
             Contact::Never => {}
             Contact::At(t) => {
                 if best.key.cmp_at(t, p) == Ordering::Greater {
                     best.key = Key::at(t, p);
-                    best.partner = Partner::Ball(j, o.counter);
+                    best.partner = Partner::Ball(j, counter);
                 }
             }
             Contact::Immediate => {
@@ -364,8 +409,23 @@ impl EventList {
                 let key = fi.max(fj).child(p);
                 if key < best.key {
                     best.key = key;
-                    best.partner = Partner::Ball(j, o.counter);
+                    best.partner = Partner::Ball(j, counter);
                 }
+            }
+        }
+    }
+
+    /// Offers the contacts of ball `i` (slot `b`) with each of `near` to `best`, with the images
+    /// `shifts` moves them to in a periodic box.
+    #[inline]
+    fn offer_balls(&self, i: u32, b: &Slot, near: &[u32], shifts: &[Vec2], best: &mut Best) {
+        if self.period.is_none() {
+            for &j in near {
+                self.offer_ball(i, b, j, best);
+            }
+        } else {
+            for (&j, &shift) in near.iter().zip(shifts) {
+                self.offer_image(i, b, j, shift, best);
             }
         }
     }
@@ -397,15 +457,18 @@ impl EventList {
 
     /// Recomputes ball `i`'s earliest physical event and its next cell crossing from scratch.
     fn predict(&mut self, i: u32) {
-        let near = self.gather(i);
-        self.predict_among(i, &near);
+        let (mut near, mut shifts) = (Near::new(), Shifts::new());
+        self.gather(i, &mut near, &mut shifts);
+        self.predict_among(i, &near, &shifts);
     }
 
     /// The balls near ball `i` (none once pocketed), with a request to load their slots: gathered
     /// ahead of the pair tests so that the trips to memory overlap instead of following one
     /// another.
-    fn gather(&self, i: u32) -> Near {
-        let mut near = Near::new();
+    fn gather(&self, i: u32, near: &mut Near, shifts: &mut Shifts) {
+        if self.period.is_some() {
+            return self.gather_images(i, near, shifts);
+        }
         let cell = self.slots[i as usize].cell;
         if cell != NOT_ON_TABLE {
             self.grid.for_each_near(cell, |j| {
@@ -415,17 +478,14 @@ impl EventList {
                 }
             });
         }
-        near
     }
 
     /// [`EventList::predict`] with ball `i`'s neighbours already gathered.
-    fn predict_among(&mut self, i: u32, near: &[u32]) {
+    fn predict_among(&mut self, i: u32, near: &[u32], shifts: &[Vec2]) {
         let b = self.slots[i as usize];
         let mut best = Best::none();
         if b.cell != NOT_ON_TABLE {
-            for &j in near {
-                self.offer_ball(i, &b, j, &mut best);
-            }
+            self.offer_balls(i, &b, near, shifts, &mut best);
             let tests = near.len() as u64 + self.offer_fixed(i, &b, b.cell, &mut best);
             self.stats.predictions += tests;
         }
@@ -438,11 +498,15 @@ impl EventList {
     /// 3 × 3 block are new candidates; its physical prediction otherwise stands.
     fn cross(&mut self, i: u32, to: u32) {
         let from = self.slots[i as usize].cell;
-        let mut near = Near::new();
-        self.grid.for_each_entering(from, to, |j| {
-            prefetch(&self.slots[j as usize]);
-            near.push(j);
-        });
+        let (mut near, mut shifts) = (Near::new(), Shifts::new());
+        if self.period.is_some() {
+            self.entering_images(i, (from, to), &mut near, &mut shifts);
+        } else {
+            self.grid.for_each_entering(from, to, |j| {
+                prefetch(&self.slots[j as usize]);
+                near.push(j);
+            });
+        }
         // copied before the cell is stored: a read of the whole slot right after a store into
         // it would wait for that store (and every store before it) to reach the cache
         let mut b = self.slots[i as usize];
@@ -451,9 +515,7 @@ impl EventList {
         self.grid.insert(i, to);
         self.slots[i as usize].cell = to;
         let mut best = std::mem::replace(&mut self.own[i as usize].phys, Best::none());
-        for &j in &near {
-            self.offer_ball(i, &b, j, &mut best);
-        }
+        self.offer_balls(i, &b, &near, &shifts, &mut best);
         let tests = near.len() as u64 + self.offer_fixed(i, &b, to, &mut best);
         self.stats.predictions += tests;
         self.own[i as usize].phys = best;
@@ -470,9 +532,10 @@ impl EventList {
         let on_table: Vec<u32> = (0..self.slots.len() as u32)
             .filter(|&i| self.slots[i as usize].cell != NOT_ON_TABLE)
             .collect();
+        let wrap = |p: Vec2| self.period.map_or(p, |b| b.wrap(p));
         let centres: Vec<Vec2> = on_table
             .iter()
-            .map(|&i| self.slots[i as usize].traj.at(self.now))
+            .map(|&i| wrap(self.slots[i as usize].traj.at(self.now)))
             .collect();
         if let Some(grid) = self.grid.relaid(&self.table, &centres) {
             self.grid = grid;
@@ -500,12 +563,18 @@ impl EventList {
 
     /// Predicts when ball `i`'s centre leaves its cell, and which cell it enters.
     fn set_exit(&mut self, i: u32) {
+        let position = match self.period {
+            Some(period) if self.slots[i as usize].cell != NOT_ON_TABLE => {
+                let out = self.sides_out(i, self.now);
+                self.slots[i as usize].traj.position - period.shift(out)
+            }
+            _ => self.slots[i as usize].traj.position,
+        };
         let b = &mut self.slots[i as usize];
         let exit = if b.cell == NOT_ON_TABLE {
             None
         } else {
-            self.grid
-                .exit(b.cell, b.traj.position, b.traj.velocity, b.traj.t0)
+            self.grid.exit(b.cell, position, b.traj.velocity, b.traj.t0)
         };
         match exit {
             Some((t, c)) => {
@@ -530,9 +599,13 @@ impl EventList {
     }
 
     fn set_velocity(&mut self, i: u32, key: &Key, velocity: Vec2) {
+        let mut position = self.slots[i as usize].traj.at(key.t);
+        if self.period.is_some() {
+            position = self.rebased(i, position, key.t);
+        }
         let b = &mut self.slots[i as usize];
         b.traj = Trajectory {
-            position: b.traj.at(key.t),
+            position,
             velocity,
             t0: key.t,
         };
@@ -666,19 +739,27 @@ impl EventList {
         prefetch(&self.own[j as usize]);
         self.grid.prefetch_near(sa.cell);
         self.grid.prefetch_near(sb.cell);
+        let (pa, mut pb) = (sa.traj.at(key.t), sb.traj.at(key.t));
+        if let Some(period) = &self.period {
+            // the image of b that touches a
+            pb = pb + period.shift(period.images(pa - pb));
+        }
         let (va, vb) = physics::ball_ball_velocities(
-            sa.traj.at(key.t),
+            pa,
             sa.traj.velocity,
             self.own[a as usize].mass,
-            sb.traj.at(key.t),
+            pb,
             sb.traj.velocity,
             self.own[b as usize].mass,
         );
         self.set_velocity(a, key, va);
         self.set_velocity(b, key, vb);
-        let (near_a, near_b) = (self.gather(a), self.gather(b));
-        self.predict_among(a, &near_a);
-        self.predict_among(b, &near_b);
+        let (mut near_a, mut shifts_a) = (Near::new(), Shifts::new());
+        let (mut near_b, mut shifts_b) = (Near::new(), Shifts::new());
+        self.gather(a, &mut near_a, &mut shifts_a);
+        self.gather(b, &mut near_b, &mut shifts_b);
+        self.predict_among(a, &near_a, &shifts_a);
+        self.predict_among(b, &near_b, &shifts_b);
         (EventKind::BallBall, a, b)
     }
 
@@ -728,18 +809,13 @@ impl EventList {
         self.now = r.t;
         let n = self.slots.len() as u32;
         for i in 0..n {
-            let b = &mut self.slots[i as usize];
             match self.pocket[i as usize] {
                 None => {
-                    b.traj = Trajectory {
-                        position: b.traj.at(r.t),
-                        velocity: -b.traj.velocity,
-                        t0: r.t,
-                    };
-                    b.counter = b.counter.wrapping_add(1);
-                    self.own[i as usize].fixed_at = r.clone();
+                    let velocity = -self.slots[i as usize].traj.velocity;
+                    self.set_velocity(i, r, velocity);
                 }
                 Some(k) => {
+                    let b = &mut self.slots[i as usize];
                     let back = 2.0 * r.t - b.traj.t0;
                     b.traj = Trajectory {
                         position: b.traj.position,
@@ -808,7 +884,7 @@ impl EventList {
                 let mut b = self.ball(i);
                 if b.pocket.is_none() {
                     b.traj = Trajectory {
-                        position: b.traj.at(t),
+                        position: self.period.map_or(b.traj.at(t), |p| p.wrap(b.traj.at(t))),
                         velocity: b.traj.velocity,
                         t0: t,
                     };
