@@ -12,28 +12,40 @@
 //! ```
 //!
 //! The lattice is the table's bounding box (`Origin` its lower left corner; the walls are not
-//! periodic, `pbc="F F F"`); positions and velocities are in the plane `z = 0`. `species` is `X`
+//! periodic, `pbc="F F F"`); positions and velocities are in the plane `z = 0`. In a periodic
+//! box the lattice is the box, `pbc="T T F"`, positions lie in the box, and a last column
+//! `image:I:3` gives the whole sides from each position to the ball's unwrapped one (as LAMMPS'
+//! image flags: unwrapped = position + image × side), for its displacement. `species` is `X`
 //! (ASE's placeholder element); `id` is the ball's number (`Ball-id`), so that a ball is followed
 //! from frame to frame although balls in pockets are left out. Numbers are written as the
 //! shortest decimals that read back to the same bits.
 
 use crate::engine::{Frame, Table};
-use crate::geometry::Vec2;
+use crate::geometry::{PeriodicBox, Vec2};
 use crate::scenario::{BallSpec, CushionSpec, Scenario};
 use std::io::{self, Write};
 
 /// The `Properties` of every frame, in column order.
 pub const PROPERTIES: &str = "species:S:1:pos:R:3:velo:R:3:radius:R:1:mass:R:1:id:I:1";
 
+/// The `Properties` of a frame in a periodic box: [`PROPERTIES`] and the images.
+pub const PERIODIC_PROPERTIES: &str =
+    "species:S:1:pos:R:3:velo:R:3:radius:R:1:mass:R:1:id:I:1:image:I:3";
+
 /// Writes `frame` of a run on `table` as one extended XYZ frame.
 pub fn write_frame(out: &mut impl Write, frame: &Frame, table: &Table) -> io::Result<()> {
     let on_table = frame.balls.iter().filter(|b| b.pocket.is_none()).count();
     let (lo, span) = (table.lo, table.hi - table.lo);
+    let periodic = table.period.is_some();
+    let (properties, pbc) = match periodic {
+        true => (PERIODIC_PROPERTIES, "T T F"),
+        false => (PROPERTIES, "F F F"),
+    };
     writeln!(out, "{on_table}")?;
     writeln!(
         out,
         "Lattice=\"{:?} 0.0 0.0 0.0 {:?} 0.0 0.0 0.0 1.0\" Origin=\"{:?} {:?} 0.0\" \
-         Properties={PROPERTIES} Time={:?} pbc=\"F F F\"",
+         Properties={properties} Time={:?} pbc=\"{pbc}\"",
         span.x, span.y, lo.x, lo.y, frame.t
     )?;
     for (i, b) in frame.balls.iter().enumerate() {
@@ -41,7 +53,7 @@ pub fn write_frame(out: &mut impl Write, frame: &Frame, table: &Table) -> io::Re
             continue;
         }
         let (p, v) = (b.traj.at(frame.t), b.traj.velocity);
-        writeln!(
+        write!(
             out,
             "X {:?} {:?} 0.0 {:?} {:?} 0.0 {:?} {:?} {}",
             p.x,
@@ -52,6 +64,11 @@ pub fn write_frame(out: &mut impl Write, frame: &Frame, table: &Table) -> io::Re
             b.mass,
             i + 1
         )?;
+        if periodic {
+            let [ix, iy] = frame.images.get(i).copied().unwrap_or_default();
+            write!(out, " {ix} {iy} 0")?;
+        }
+        writeln!(out)?;
     }
     Ok(())
 }
@@ -65,20 +82,23 @@ pub struct Sample {
     pub origin: (f64, f64),
     /// The lattice's extent along x and y.
     pub size: (f64, f64),
+    /// Whether the lattice is a periodic box (`pbc="T T F"`).
+    pub periodic: bool,
     /// Each ball on the table: its number, position, velocity, radius and mass.
     pub balls: Vec<SampledBall>,
 }
 
 impl Sample {
     /// A scenario that starts from this sample: its balls at time 0 where they are in it, in
-    /// a box of elastic cushions around its lattice, until `until`, named `name`. The balls are
+    /// its periodic box or a box of elastic cushions around its lattice, until `until`, named
+    /// `name`. The balls are
     /// numbered afresh in the sample's order (a sample leaves out the balls in pockets).
     pub fn to_scenario(&self, name: &str, until: f64) -> Scenario {
         let (x0, y0) = self.origin;
         let (x1, y1) = (x0 + self.size.0, y0 + self.size.1);
         // clockwise from the left side, so the table lies on each cushion's right
         let corners = [(x0, y0), (x0, y1), (x1, y1), (x1, y0)].map(|(x, y)| Vec2::new(x, y));
-        Scenario {
+        let mut s = Scenario {
             name: name.to_string(),
             until,
             balls: self
@@ -105,7 +125,15 @@ impl Sample {
             pockets: Vec::new(),
             sectors: None,
             periodic: None,
+        };
+        if self.periodic {
+            s.cushions.clear();
+            s.periodic = Some(PeriodicBox {
+                lo: Vec2::new(x0, y0),
+                size: Vec2::new(self.size.0, self.size.1),
+            });
         }
+        s
     }
 }
 
@@ -131,6 +159,8 @@ pub struct SampledBall {
     pub radius: f64,
     /// Its mass.
     pub mass: f64,
+    /// In a periodic box, the whole sides from its position to its unwrapped one; zero else.
+    pub image: (i64, i64),
 }
 
 /// Why extended XYZ text could not be read: the line (from 1) and what is wrong.
@@ -165,7 +195,10 @@ pub fn read(text: &str) -> Result<Vec<Sample>, XyzError> {
             let (k, line) = lines
                 .next()
                 .ok_or_else(|| bad(last + 1, format!("the frame ends before its {n} balls")))?;
-            sample.balls.push(ball_of(line).map_err(|m| bad(k, m))?);
+            let columns = if sample.periodic { 13 } else { 10 };
+            sample
+                .balls
+                .push(ball_of(line, columns).map_err(|m| bad(k, m))?);
             last = k;
         }
         out.push(sample);
@@ -185,8 +218,19 @@ fn comment_of(line: &str) -> Result<Sample, String> {
             None => rest.split_whitespace().next().unwrap_or(""),
         })
     };
-    if value("Properties")? != PROPERTIES {
-        return Err(format!("Properties must be {PROPERTIES}"));
+    let properties = value("Properties")?;
+    if properties != PROPERTIES && properties != PERIODIC_PROPERTIES {
+        return Err(format!(
+            "Properties must be {PROPERTIES} (or, in a periodic box, {PERIODIC_PROPERTIES})"
+        ));
+    }
+    let periodic = properties == PERIODIC_PROPERTIES;
+    let pbc = value("pbc").unwrap_or("F F F");
+    if periodic != (pbc == "T T F") {
+        return Err(format!(
+            "pbc=\"{pbc}\" does not go with Properties={properties} (the image column is for \
+             a box periodic along x and y, pbc=\"T T F\")"
+        ));
     }
     let numbers = |key: &str| -> Result<Vec<f64>, String> {
         value(key)?
@@ -205,16 +249,29 @@ fn comment_of(line: &str) -> Result<Sample, String> {
         t: t[0],
         origin: (origin[0], origin[1]),
         size: (lattice[0], lattice[4]),
+        periodic,
         balls: Vec::new(),
     })
 }
 
-/// One ball's line.
-fn ball_of(line: &str) -> Result<SampledBall, String> {
+/// One ball's line, of `columns` columns (13 with the images).
+fn ball_of(line: &str, columns: usize) -> Result<SampledBall, String> {
     let fields: Vec<&str> = line.split_whitespace().collect();
-    if fields.len() != 10 {
-        return Err(format!("expected 10 columns, found {}", fields.len()));
+    if fields.len() != columns {
+        return Err(format!(
+            "expected {columns} columns, found {}",
+            fields.len()
+        ));
     }
+    let whole = |k: usize| -> Result<i64, String> {
+        fields[k]
+            .parse()
+            .map_err(|_| format!("column {}: `{}` is not a whole number", k + 1, fields[k]))
+    };
+    let image = match columns {
+        13 => (whole(10)?, whole(11)?),
+        _ => (0, 0),
+    };
     let x = |k: usize| -> Result<f64, String> {
         fields[k]
             .parse()
@@ -229,6 +286,7 @@ fn ball_of(line: &str) -> Result<SampledBall, String> {
         velocity: (x(4)?, x(5)?),
         radius: x(7)?,
         mass: x(8)?,
+        image,
     })
 }
 
@@ -245,7 +303,11 @@ mod tests {
         let mut balls = BallState::initial(&s, 0.0);
         balls[1].traj.velocity.y = 0.1 + 0.2; // not a short decimal
         let mut text = Vec::new();
-        let first = Frame { t: 0.0, balls };
+        let first = Frame {
+            t: 0.0,
+            balls,
+            images: Vec::new(),
+        };
         write_frame(&mut text, &first, &table).unwrap();
         let mut later = first.clone();
         later.t = 1.25;
@@ -303,5 +365,47 @@ mod tests {
             read(&format!("{good}X 1 2 0 0 0 0 1 1 7\n")).unwrap()[0].balls[0].id,
             7
         );
+    }
+
+    #[test]
+    fn a_periodic_sample_keeps_its_box_and_images() {
+        let p = builtin::Params {
+            balls: Some(30),
+            boundary: Some(builtin::Boundary::Periodic),
+            ..builtin::Params::default()
+        };
+        let s = builtin::build("disks", &p).unwrap();
+        let table = Table::new(&s);
+        let mut el = crate::engine::event_list::EventList::new(&s, Default::default());
+        let out = el.run(5.0, &mut crate::engine::Ignore).unwrap();
+        let frame = Frame {
+            t: 5.0,
+            balls: out.balls,
+            images: el.images_at(5.0),
+        };
+        assert!(
+            frame.images.iter().any(|&i| i != [0, 0]),
+            "no ball crossed a side"
+        );
+        let mut text = Vec::new();
+        write_frame(&mut text, &frame, &table).unwrap();
+        let text = String::from_utf8(text).unwrap();
+        assert!(text.contains("pbc=\"T T F\""), "{text}");
+        let back = read(&text).unwrap().remove(0);
+        assert!(back.periodic);
+        let unwrapped = el.unwrapped_at(5.0);
+        let side = back.size;
+        for (b, u) in back.balls.iter().zip(&unwrapped) {
+            let x = b.position.0 + b.image.0 as f64 * side.0;
+            let y = b.position.1 + b.image.1 as f64 * side.1;
+            assert!((x - u.x).abs() < 1e-9 && (y - u.y).abs() < 1e-9);
+        }
+        let again = back.to_scenario("again", 1.0);
+        assert_eq!(again.periodic, s.periodic);
+        assert!(again.cushions.is_empty());
+        again.validate().unwrap();
+        // a periodic header without the images, or the images without a periodic box
+        let bad = text.replace("pbc=\"T T F\"", "pbc=\"F F F\"");
+        assert!(read(&bad).unwrap_err().message.contains("does not go with"));
     }
 }

@@ -59,7 +59,9 @@ class State:
 
     ``position`` and ``velocity`` are ``(N, 2)`` float arrays; ``radius`` and ``mass`` have one
     entry per ball; ``pocket`` is the pocket (from 0) a ball dropped into, -1 for a ball still
-    on the table (whose position is where its centre crossed the pocket line).
+    on the table (whose position is where its centre crossed the pocket line). In a periodic
+    box, a sample's ``image`` is an ``(N, 2)`` int array: the whole sides from each position (in
+    the box) to the ball's unwrapped position; ``None`` elsewhere.
     """
 
     t: float
@@ -68,40 +70,48 @@ class State:
     radius: np.ndarray
     mass: np.ndarray
     pocket: np.ndarray
+    image: np.ndarray | None = None
 
     @classmethod
     def _of(cls, d: dict[str, Any]) -> State:
-        return cls(d["t"], d["position"], d["velocity"], d["radius"], d["mass"], d["pocket"])
+        return cls(d["t"], d["position"], d["velocity"], d["radius"], d["mass"], d["pocket"],
+                   d.get("image"))
 
 
 @dataclass(frozen=True)
 class Table:
     """A table's geometry: ``cushions`` and ``pockets`` as ``(M, 2, 2)`` arrays of segment ends,
-    and the corners ``lo`` and ``hi`` of its bounding box."""
+    and the corners ``lo`` and ``hi`` of its bounding box; ``periodic`` when it is a periodic box
+    (no cushions, and ``lo``, ``hi`` the box)."""
 
     cushions: np.ndarray
     pockets: np.ndarray
     lo: tuple[float, float]
     hi: tuple[float, float]
+    periodic: bool = False
 
     @classmethod
     def _of(cls, d: dict[str, Any]) -> Table:
-        return cls(d["cushions"].reshape(-1, 2, 2), d["pockets"].reshape(-1, 2, 2), d["lo"], d["hi"])
+        return cls(d["cushions"].reshape(-1, 2, 2), d["pockets"].reshape(-1, 2, 2), d["lo"], d["hi"],
+                   bool(d.get("periodic", False)))
 
 
 @dataclass(frozen=True)
 class Sample:
     """One frame read from extended XYZ: the balls on the table (``id`` is each one's number,
-    ``Ball-id``), the lattice's ``origin`` and ``size``."""
+    ``Ball-id``), the lattice's ``origin`` and ``size``; in a periodic box (``periodic``) each
+    ball's ``image`` (whole sides to its unwrapped position; zeros otherwise)."""
 
     t: float
     origin: tuple[float, float]
     size: tuple[float, float]
+    periodic: bool
     id: np.ndarray
     position: np.ndarray
     velocity: np.ndarray
     radius: np.ndarray
     mass: np.ndarray
+    image: np.ndarray
 
 
 def _events(columns: dict[str, np.ndarray] | None) -> np.ndarray | None:
@@ -210,10 +220,17 @@ class Scenario:
         radius: float | Sequence[float] | np.ndarray = 1.0,
         mass: float | Sequence[float] | np.ndarray = 1.0,
         until: float = 10.0,
+        periodic: bool = False,
     ) -> Scenario:
         """Balls in a ``width`` x ``height`` box of elastic cushions with its corner at the
-        origin (:meth:`from_arrays` with the box's four sides)."""
+        origin (:meth:`from_arrays` with the box's four sides), or, if ``periodic``, in a
+        periodic box (positions outside it are taken into it)."""
         w, h = float(width), float(height)
+        if periodic:
+            s = cls.from_arrays(positions, velocities, [], radius=radius, mass=mass, until=until,
+                                name="box")
+            box = f'[box]\nsize = [{_toml_float(w)}, {_toml_float(h)}]\nboundary = "periodic"\n'
+            return cls(s.toml + box, "box")
         sides = [[(0.0, 0.0), (0.0, h)], [(0.0, h), (w, h)], [(w, h), (w, 0.0)],
                  [(w, 0.0), (0.0, 0.0)]]
         return cls.from_arrays(positions, velocities, sides, radius=radius, mass=mass,
@@ -285,6 +302,7 @@ def _ask(
         "lattice": params.get("lattice"),
         "temperature": params.get("temperature"),
         "mixture": params.get("mixture"),
+        "boundary": params.get("boundary"),
     }
     return spec, ask
 
@@ -310,6 +328,7 @@ def run(
     lattice: str | None = None,
     temperature: float | None = None,
     mixture: tuple[float, float] | None = None,
+    boundary: str | None = None,
 ) -> Result:
     """Runs a scenario to ``until`` (default: the scenario's own end) and returns its results.
 
@@ -317,9 +336,9 @@ def run(
     ``"objects"`` or ``"time-warp"`` (``workers`` threads); ``sectors`` (``"auto"`` or
     ``(nx, ny)``) runs the objects on a sectored table. ``check`` checks invariants at every
     event. ``balls``, ``seed``, ``area_fraction``, ``radius``, ``speed_max``, ``lattice``
-    (``"triangular"`` or ``"square"``), ``temperature`` and ``mixture`` (``(F, Q)``: a fraction F
-    of the disks Q times as wide) are the built-in generators' parameters (``builtins()`` says
-    which each takes). ``observe_every`` (from ``observe_from``) adds the
+    (``"triangular"`` or ``"square"``), ``temperature``, ``mixture`` (``(F, Q)``: a fraction F
+    of the disks Q times as wide) and ``boundary`` (``"walled"`` or ``"periodic"``) are the
+    built-in generators' parameters (``builtins()`` says which each takes). ``observe_every`` (from ``observe_from``) adds the
     pressure, the compressibility factor ``z``, the temperature ``kt`` and the collision rate,
     each a block mean with its standard error, to ``summary["observables"]``. The engine runs
     with Python's lock released, so threads can run simulations side by side.
@@ -327,7 +346,7 @@ def run(
     spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, sample_every, events,
                      dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
                           speed_max=speed_max, lattice=lattice, temperature=temperature,
-                          mixture=mixture), (observe_every, observe_from))
+                          mixture=mixture, boundary=boundary), (observe_every, observe_from))
     d = _native.run(spec, ask)
     return Result(
         summary=json.loads(d["summary"]),
@@ -388,6 +407,7 @@ def stream(
     lattice: str | None = None,
     temperature: float | None = None,
     mixture: tuple[float, float] | None = None,
+    boundary: str | None = None,
 ) -> EventStream:
     """Starts a run in the background and returns its events in chunks of at most ``chunk``.
 
@@ -397,7 +417,7 @@ def stream(
     spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, None, True,
                      dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
                           speed_max=speed_max, lattice=lattice, temperature=temperature,
-                          mixture=mixture))
+                          mixture=mixture, boundary=boundary))
     return EventStream(_native.stream(spec, ask, chunk))
 
 
@@ -449,10 +469,12 @@ def write_xyz(path: str | Path, states: State | Sequence[State], table: Table) -
     frames = [
         (float(s.t), np.ascontiguousarray(s.position, dtype=float),
          np.ascontiguousarray(s.velocity, dtype=float), np.ascontiguousarray(s.radius, dtype=float),
-         np.ascontiguousarray(s.mass, dtype=float), np.ascontiguousarray(s.pocket, dtype=np.int32))
+         np.ascontiguousarray(s.mass, dtype=float), np.ascontiguousarray(s.pocket, dtype=np.int32),
+         None if s.image is None else np.ascontiguousarray(s.image, dtype=np.int64))
         for s in _frames(states)
     ]
-    _native.write_xyz(str(path), frames, tuple(map(float, table.lo)), tuple(map(float, table.hi)))
+    _native.write_xyz(str(path), frames, tuple(map(float, table.lo)), tuple(map(float, table.hi)),
+                      table.periodic)
 
 
 def read_xyz(path: str | Path) -> list[Sample]:

@@ -30,7 +30,11 @@ def experiment(
     font: Any = ...,
 ) -> None: ...
 def write_xyz(
-    path: str, frames: list[tuple[Any, ...]], lo: tuple[float, float], hi: tuple[float, float]
+    path: str,
+    frames: list[tuple[Any, ...]],
+    lo: tuple[float, float],
+    hi: tuple[float, float],
+    periodic: bool,
 ) -> None: ...
 def read_xyz(path: str) -> list[dict[str, Any]]: ...
 

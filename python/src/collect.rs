@@ -1,6 +1,6 @@
 //! What a run hands to Python: its events as columns, its samples, its final state.
 
-use numpy::PyArray1;
+use numpy::{PyArray1, PyArrayMethods};
 use poolsim::engine::{
     BallState, Event, EventKind, Fixed, Frame, Observer, RunError, Table, World,
 };
@@ -57,13 +57,16 @@ pub struct Snapshot {
     radius: Vec<f64>,
     mass: Vec<f64>,
     pocket: Vec<i32>,
+    /// In a periodic box, each ball's image (pairs of whole sides); empty else.
+    image: Vec<i64>,
 }
 
 impl Snapshot {
-    /// The balls fixed at `t`.
-    pub fn of(t: f64, balls: &[BallState]) -> Snapshot {
+    /// The balls fixed at `t`, with their images in a periodic box (`images`, empty else).
+    pub fn of(t: f64, balls: &[BallState], images: &[[i64; 2]]) -> Snapshot {
         let mut s = Snapshot {
             t,
+            image: images.iter().flatten().copied().collect(),
             position: Vec::with_capacity(2 * balls.len()),
             velocity: Vec::with_capacity(2 * balls.len()),
             radius: Vec::with_capacity(balls.len()),
@@ -94,6 +97,10 @@ impl Snapshot {
         d.set_item("radius", PyArray1::from_vec(py, self.radius))?;
         d.set_item("mass", PyArray1::from_vec(py, self.mass))?;
         d.set_item("pocket", PyArray1::from_vec(py, self.pocket))?;
+        if !self.image.is_empty() {
+            let n = self.image.len() / 2;
+            d.set_item("image", PyArray1::from_vec(py, self.image).reshape([n, 2])?)?;
+        }
         Ok(d)
     }
 }
@@ -121,7 +128,7 @@ impl Collected {
 
     /// Takes the final state from the run's report; returns what the observables came to.
     pub fn finish(&mut self, report: &Report) -> Option<Observed> {
-        self.last = Some(Snapshot::of(report.outcome.t, &report.outcome.balls));
+        self.last = Some(Snapshot::of(report.outcome.t, &report.outcome.balls, &[]));
         self.observables.take().map(|o| o.finish(report.outcome.t))
     }
 
@@ -162,7 +169,8 @@ impl Observer for Collected {
     }
 
     fn on_frame(&mut self, frame: &Frame, _: &Table) -> Result<(), RunError> {
-        self.samples.push(Snapshot::of(frame.t, &frame.balls));
+        self.samples
+            .push(Snapshot::of(frame.t, &frame.balls, &frame.images));
         Ok(())
     }
 }

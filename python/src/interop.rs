@@ -17,11 +17,12 @@ type FrameIn<'py> = (
     PyReadonlyArray1<'py, f64>,
     PyReadonlyArray1<'py, f64>,
     PyReadonlyArray1<'py, i32>,
+    Option<PyReadonlyArray2<'py, i64>>,
 );
 
 /// The frame's balls, fixed at its time.
 fn frame_of(f: &FrameIn<'_>) -> PyResult<Frame> {
-    let (t, pos, vel, radius, mass, pocket) = f;
+    let (t, pos, vel, radius, mass, pocket, image) = f;
     let (pos, vel) = (pos.as_array(), vel.as_array());
     let (radius, mass, pocket) = (radius.as_array(), mass.as_array(), pocket.as_array());
     let n = pos.nrows();
@@ -47,16 +48,32 @@ fn frame_of(f: &FrameIn<'_>) -> PyResult<Frame> {
             pocket: u32::try_from(pocket[i]).ok(),
         })
         .collect();
-    Ok(Frame { t: *t, balls })
+    let images = match image {
+        None => Vec::new(),
+        Some(image) => {
+            let image = image.as_array();
+            if image.dim() != (n, 2) {
+                return Err(value_error("a frame's images must be an (N, 2) array"));
+            }
+            (0..n).map(|i| [image[(i, 0)], image[(i, 1)]]).collect()
+        }
+    };
+    Ok(Frame {
+        t: *t,
+        balls,
+        images,
+    })
 }
 
-/// Writes frames as extended XYZ to `path`, the lattice the box from `lo` to `hi`.
+/// Writes frames as extended XYZ to `path`, the lattice the box from `lo` to `hi` (a periodic
+/// box if `periodic`, each frame then with its images).
 #[pyfunction]
 pub fn write_xyz(
     path: &str,
     frames: Vec<FrameIn<'_>>,
     lo: (f64, f64),
     hi: (f64, f64),
+    periodic: bool,
 ) -> PyResult<()> {
     let table = Table {
         n_balls: 0,
@@ -65,6 +82,10 @@ pub fn write_xyz(
         corners: Vec::new(),
         lo: Vec2::new(lo.0, lo.1),
         hi: Vec2::new(hi.0, hi.1),
+        period: periodic.then(|| poolsim::geometry::PeriodicBox {
+            lo: Vec2::new(lo.0, lo.1),
+            size: Vec2::new(hi.0 - lo.0, hi.1 - lo.1),
+        }),
     };
     let file = std::fs::File::create(path).map_err(|e| value_error(format!("{path}: {e}")))?;
     let mut out = std::io::BufWriter::new(file);
@@ -87,6 +108,7 @@ pub fn read_xyz<'py>(py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyList>
         d.set_item("t", s.t)?;
         d.set_item("origin", s.origin)?;
         d.set_item("size", s.size)?;
+        d.set_item("periodic", s.periodic)?;
         let flat = |f: &dyn Fn(&poolsim::samples::SampledBall) -> (f64, f64)| -> Vec<f64> {
             s.balls
                 .iter()
@@ -110,6 +132,15 @@ pub fn read_xyz<'py>(py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyList>
             "mass",
             PyArray1::from_vec(py, s.balls.iter().map(|b| b.mass).collect()),
         )?;
+        let image: Vec<i64> = s
+            .balls
+            .iter()
+            .flat_map(|b| [b.image.0, b.image.1])
+            .collect();
+        d.set_item(
+            "image",
+            PyArray1::from_vec(py, image).reshape([s.balls.len(), 2])?,
+        )?;
         out.append(d)?;
     }
     Ok(out)
@@ -131,5 +162,6 @@ pub fn table_dict<'py>(py: Python<'py>, table: &Table) -> PyResult<Bound<'py, Py
     d.set_item("pockets", segments(table.pockets.clone())?)?;
     d.set_item("lo", (table.lo.x, table.lo.y))?;
     d.set_item("hi", (table.hi.x, table.hi.y))?;
+    d.set_item("periodic", table.period.is_some())?;
     Ok(d)
 }

@@ -45,12 +45,23 @@ pub struct Ask {
     lattice: Option<String>,
     temperature: Option<f64>,
     mixture: Option<(f64, f64)>,
+    boundary: Option<String>,
 }
 
 impl Ask {
     /// The scenario and the run's settings, checked.
     pub fn prepare(&self, spec: &str) -> PyResult<(Scenario, RunConfig)> {
-        use poolsim::scenario::builtin::{Lattice, Mixture};
+        use poolsim::scenario::builtin::{Boundary, Lattice, Mixture};
+        let boundary = match self.boundary.as_deref() {
+            None => None,
+            Some("walled") => Some(Boundary::Walled),
+            Some("periodic") => Some(Boundary::Periodic),
+            Some(other) => {
+                return Err(value_error(format!(
+                    "boundary: walled or periodic, got {other:?}"
+                )))
+            }
+        };
         let lattice = match self.lattice.as_deref() {
             None => None,
             Some("triangular") => Some(Lattice::Triangular),
@@ -70,6 +81,7 @@ impl Ask {
             lattice,
             temperature: self.temperature,
             mixture: self.mixture.map(|(large, ratio)| Mixture { large, ratio }),
+            boundary,
         };
         let scenario = scenario_of(spec, self.toml.as_deref(), &params)?;
         let cfg = config_of(self, &scenario)?;

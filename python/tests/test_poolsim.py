@@ -325,3 +325,35 @@ def test_the_mean_squared_displacement_grows_from_zero_then_levels_off():
     (x0, _), (x1, _) = r.table.lo, r.table.hi
     # bounded by the box: two uniform points in a square of side L are L^2 / 3 apart on average
     assert msd[-10:].mean() < 0.5 * (x1 - x0) ** 2
+
+
+def test_in_a_periodic_box_displacements_grow_without_bound_and_samples_keep_images(tmp_path):
+    from poolsim.analysis import mean_squared_displacement, pair_correlation
+
+    r = poolsim.run("disks", balls=100, area_fraction=0.3, until=400, sample_every=10.0,
+                    events=False, boundary="periodic")
+    assert r.table.periodic and len(r.table.cushions) == 0
+    (x0, y0), (x1, y1) = r.table.lo, r.table.hi
+    for s in r.samples:
+        assert np.all((s.position >= (x0, y0)) & (s.position < (x1, y1)))
+    t, msd = mean_squared_displacement(r.samples, r.table)
+    # diffusive, past the box's size: no wall stops it
+    assert msd[-1] > 1.2 * (x1 - x0) ** 2
+    assert msd[-1] > 5.0 * msd[len(msd) // 5]
+    with pytest.raises(ValueError, match="images"):
+        mean_squared_displacement([r.final], r.table)
+    # the samples' images survive extended XYZ, and g(r) counts pairs across the sides
+    path = tmp_path / "periodic.xyz"
+    poolsim.write_xyz(path, r.samples, r.table)
+    back = poolsim.read_xyz(path)
+    assert back[-1].periodic and np.array_equal(back[-1].image, r.samples[-1].image)
+    rg, g = pair_correlation(r.samples[-1], r.table, r_max=(x1 - x0) / 2, bins=40)
+    assert np.all(g[rg < 1.5] == 0.0) and abs(g[rg > 6.0].mean() - 1.0) < 0.25
+    with pytest.raises(ValueError, match="half"):
+        pair_correlation(r.samples[-1], r.table, r_max=x1 - x0)
+    boxed = poolsim.Scenario.box(10.0, 10.0, [[5.0, 1.0], [12.0, 1.0]], [[1.0, 0.0], [0.0, 0.0]],
+                                 periodic=True, until=20.0)
+    # Ball-2 is taken in to x = 2; Ball-1 leaves through the right side and meets it from its
+    # left when it reaches x = 10, the box's x = 0
+    ev = poolsim.run(boxed).events
+    assert len(ev) >= 1 and abs(ev["t"][0] - 5.0) < 1e-12

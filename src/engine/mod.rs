@@ -350,6 +350,9 @@ pub struct Frame {
     pub t: f64,
     /// Every ball, fixed at `t` (a pocketed ball keeps its entry fix and names its pocket).
     pub balls: Vec<BallState>,
+    /// In a periodic box, each ball's image: the whole sides along x and y from its position in
+    /// the box to its unwrapped position; empty where the engine keeps none (a walled table).
+    pub images: Vec<[i64; 2]>,
 }
 
 /// What every engine offers once set up: run on to a time, reporting each physical event to an

@@ -307,6 +307,7 @@ fn run_plain(
                     let f = frame.get_or_insert_with(|| Frame {
                         t,
                         balls: Vec::with_capacity(n),
+                        images: Vec::new(),
                     });
                     debug_assert_eq!(f.balls.len(), ball as usize, "balls draw in order");
                     f.balls.push(BallState {

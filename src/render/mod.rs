@@ -202,6 +202,7 @@ impl History {
             balls: (0..self.pieces.len())
                 .map(|i| self.state_at(i, t))
                 .collect(),
+            images: Vec::new(),
         }
     }
 
@@ -437,6 +438,7 @@ fn chunked(
             Frame {
                 t,
                 balls: o.balls.iter().map(|b| fix_at(*b, t)).collect(),
+                images: Vec::new(),
             },
             counts,
             messages_of(&e),

@@ -709,6 +709,7 @@ impl EventList {
                 let frame = Frame {
                     t: f,
                     balls: self.state_at(f),
+                    images: self.images_at(f),
                 };
                 obs.on_frame(&frame, &self.table)?;
                 return Ok(true);

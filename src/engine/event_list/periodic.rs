@@ -88,6 +88,22 @@ impl EventList {
         period.shift(period.images(target - there))
     }
 
+    /// In a periodic box, every ball's image at time `t` (not before the last event): the whole
+    /// sides from its position in the box to its unwrapped one; empty in a walled box.
+    pub fn images_at(&self, t: f64) -> Vec<[i64; 2]> {
+        let Some(b) = self.period else {
+            return Vec::new();
+        };
+        self.unwrapped_at(t)
+            .into_iter()
+            .zip(&self.slots)
+            .map(|(u, slot)| {
+                let (x, y) = b.images(u - b.wrap(slot.traj.at(t)));
+                [x as i64, y as i64]
+            })
+            .collect()
+    }
+
     /// Every ball's unwrapped centre at time `t` (not before the last event): its position had
     /// it never been taken back into the box. In a walled box, its centre.
     pub fn unwrapped_at(&self, t: f64) -> Vec<Vec2> {
