@@ -129,6 +129,13 @@ impl Trajectory {
     }
 }
 
+/// The whole number nearest `x` (halves away from zero), for `|x|` below 2^62: by a cast, not
+/// `f64::round`, which is a library call on x86-64 without SSE4.1.
+#[inline]
+pub fn nearest_whole(x: f64) -> f64 {
+    ((x.abs() + 0.5) as i64 as f64).copysign(x)
+}
+
 /// A rectangular periodic box: the plane folded onto a torus, so that a centre leaving through
 /// one side comes back through the opposite one. Wrapped positions lie in `[lo, lo + size)`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -146,10 +153,14 @@ impl PeriodicBox {
     }
 
     /// The whole numbers of sides, along x and y, that the separation `d` exceeds its minimum
-    /// image by (rounded to the nearest).
+    /// image by (rounded to the nearest; a separation of exactly half a side, which has two
+    /// nearest images, may go either way).
     #[inline]
     pub fn images(&self, d: Vec2) -> (f64, f64) {
-        ((d.x / self.size.x).round(), (d.y / self.size.y).round())
+        (
+            nearest_whole(d.x / self.size.x),
+            nearest_whole(d.y / self.size.y),
+        )
     }
 
     /// The translation by `m` sides along x and y.

@@ -517,6 +517,16 @@ impl Grid {
     /// Starts loading the 3 × 3 block of cells around cell `c` (if it is a cell) into cache.
     #[inline]
     pub fn prefetch_near(&self, c: u32) {
+        if self.layouts.periodic {
+            // the middle cell of each row is next to one of the others in memory
+            let (xs, ys) = self.wrapped_around(c);
+            for y in ys {
+                for x in [xs[0], xs[2]] {
+                    prefetch(&self.slots[(y * self.nx + x) as usize * self.cap]);
+                }
+            }
+            return;
+        }
         if self.general {
             self.prefetch_block(c);
             return;
@@ -538,6 +548,10 @@ impl Grid {
     /// in `c` itself).
     #[inline]
     pub fn for_each_near(&self, c: u32, mut f: impl FnMut(u32)) {
+        if self.layouts.periodic {
+            self.for_each_near_image(c, |j, _| f(j));
+            return;
+        }
         if self.general {
             self.for_each_in_block(c, &mut f);
             return;
@@ -598,10 +612,16 @@ impl Grid {
                 let (cx, cy) = (i64::from(c % self.nx), i64::from(c / self.nx));
                 let (nx, ny) = (i64::from(self.nx), i64::from(self.ny));
                 out[0] = c;
+                // one side over at most: a comparison, not a division, wraps it round
+                let wrap = |v: i64, n: i64| match v {
+                    _ if v < 0 => v + n,
+                    _ if v >= n => v - n,
+                    _ => v,
+                };
                 for (k, &(dx, dy)) in AROUND.iter().enumerate() {
                     let (mut x, mut y) = (cx + i64::from(dx), cy + i64::from(dy));
                     if self.layouts.periodic {
-                        (x, y) = (x.rem_euclid(nx), y.rem_euclid(ny));
+                        (x, y) = (wrap(x, nx), wrap(y, ny));
                     }
                     if (0..nx).contains(&x) && (0..ny).contains(&y) {
                         out[k + 1] = (y * nx + x) as u32;
@@ -704,7 +724,25 @@ impl Grid {
     /// In a periodic box: calls `f` with every ball in the 3 × 3 block of cells around cell `c`
     /// (including `c`), and with the offset of its cell from `c` in cells (each of `-1, 0, 1`
     /// along x and y): which image of the ball is the neighbour.
+    #[inline]
     pub fn for_each_near_image(&self, c: u32, mut f: impl FnMut(u32, (i32, i32))) {
+        if self.spill.is_empty() {
+            // nothing spilled: each cell's balls are its slots up to the first `NIL`
+            let (xs, ys) = self.wrapped_around(c);
+            for (y, dy) in ys.into_iter().zip(-1..=1) {
+                let row = y * self.nx;
+                for (x, dx) in xs.into_iter().zip(-1..=1) {
+                    let cell = (row + x) as usize * self.cap;
+                    for &j in &self.slots[cell..cell + self.cap] {
+                        if j == NIL {
+                            break;
+                        }
+                        f(j, (dx, dy));
+                    }
+                }
+            }
+            return;
+        }
         let block = self.block(c);
         for (&n, offset) in block.iter().zip([(0, 0)].into_iter().chain(AROUND)) {
             if n != NIL {
@@ -729,12 +767,27 @@ impl Grid {
             }
         };
         let (sx, sy) = (step(tx, fx, self.nx), step(ty, fy, self.ny));
-        let block = self.block(to);
-        for (&n, (dx, dy)) in block.iter().zip([(0, 0)].into_iter().chain(AROUND)) {
-            if n != NIL && ((dx + sx).abs() > 1 || (dy + sy).abs() > 1) {
-                self.for_each_in(n, &mut |j| f(j, (dx, dy)));
+        let (xs, ys) = self.wrapped_around(to);
+        for (y, dy) in ys.into_iter().zip(-1..=1) {
+            for (x, dx) in xs.into_iter().zip(-1..=1) {
+                if (dx + sx).abs() > 1 || (dy + sy).abs() > 1 {
+                    self.for_each_in(y * self.nx + x, &mut |j| f(j, (dx, dy)));
+                }
             }
         }
+    }
+
+    /// In a periodic box, the columns and rows of the 3 × 3 block around cell `c`, from the
+    /// lower left, wrapped round the box.
+    #[inline]
+    fn wrapped_around(&self, c: u32) -> ([u32; 3], [u32; 3]) {
+        let (cx, cy) = (c % self.nx, c / self.nx);
+        let before = |v: u32, n: u32| if v == 0 { n - 1 } else { v - 1 };
+        let after = |v: u32, n: u32| if v + 1 == n { 0 } else { v + 1 };
+        (
+            [before(cx, self.nx), cx, after(cx, self.nx)],
+            [before(cy, self.ny), cy, after(cy, self.ny)],
+        )
     }
 
     /// The size of a cell along x and y.

@@ -219,6 +219,8 @@ pub struct EventList {
     /// In a periodic box, the whole sides along x and y to add to each ball's trajectory for its
     /// unwrapped position (how far it has travelled across the box); empty in a walled box.
     unwrap: Vec<(f64, f64)>,
+    /// In a periodic box, the inverses of its sides (zero in a walled box).
+    inverse_size: Vec2,
 }
 
 /// Options of the event-list engine.
@@ -302,6 +304,7 @@ impl EventList {
             instant: InstantCap::new(n),
             look_in: 0,
             period,
+            inverse_size: period.map_or(Vec2::ZERO, |b| Vec2::new(1.0 / b.size.x, 1.0 / b.size.y)),
             unwrap: if period.is_some() {
                 vec![(0.0, 0.0); n]
             } else {

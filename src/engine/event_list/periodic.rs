@@ -15,7 +15,7 @@
 //! crossed, from which its unwrapped position follows.
 
 use super::{EventList, Near, Shifts, NOT_ON_TABLE};
-use crate::geometry::{PeriodicBox, Vec2};
+use crate::geometry::{nearest_whole, PeriodicBox, Vec2};
 use pdes_kernel::prefetch::prefetch;
 
 impl EventList {
@@ -80,12 +80,17 @@ impl EventList {
     /// The shift (whole sides) that moves ball `j` to its image in the cell `offset` cells away
     /// from the cell of a ball now at `here`: the offset is below a third of the box, so the
     /// nearest whole number of sides is that image's.
+    #[inline]
     fn image_shift(&self, here: Vec2, j: u32, (dx, dy): (i32, i32)) -> Vec2 {
-        let period = self.period();
-        let cell = self.grid.cell_size();
+        let (size, cell) = (self.period().size, self.grid.cell_size());
         let target = here + Vec2::new(f64::from(dx) * cell.x, f64::from(dy) * cell.y);
-        let there = self.slots[j as usize].traj.at(self.now);
-        period.shift(period.images(target - there))
+        let d = target - self.slots[j as usize].traj.at(self.now);
+        // the offset is a whole number of sides and less than a third of one: multiplying by
+        // the sides' inverses rounds to the same whole numbers as dividing would
+        Vec2::new(
+            nearest_whole(d.x * self.inverse_size.x) * size.x,
+            nearest_whole(d.y * self.inverse_size.y) * size.y,
+        )
     }
 
     /// In a periodic box, every ball's image at time `t` (not before the last event): the whole
