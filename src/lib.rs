@@ -19,6 +19,8 @@ pub mod check;
 pub mod checkpoint;
 pub mod engine;
 #[cfg(feature = "pictures")]
+pub mod eos_study;
+#[cfg(feature = "pictures")]
 pub mod experiment;
 pub mod geometry;
 pub mod memory;

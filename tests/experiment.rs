@@ -1,6 +1,7 @@
 //! `poolsim experiment thesis --quick` end to end: every file is written, the tables carry the
 //! thesis' numbers beside ours, and the figures are real SVG and PNG files. Only what the data
-//! show robustly across seeds is asserted; nothing about timing.
+//! show robustly across seeds is asserted; nothing about timing. `poolsim experiment eos
+//! --quick`: the equation of state agrees with the literature within its own error bars.
 
 use poolsim::experiment::{run, ExperimentOptions, Which};
 use serde_json::Value;
@@ -29,6 +30,7 @@ fn quick(dir: &Path) {
         balls: None,
         quick: true,
         font: None,
+        area_fractions: None,
     };
     run(&args, &mut |_| {}).expect("the quick experiment runs");
 }
@@ -149,6 +151,7 @@ fn a_missing_font_is_a_clear_error_after_the_tables() {
         balls: Some(vec![4]),
         quick: true,
         font: Some(dir.path().join("no-such-font.ttf")),
+        area_fractions: None,
     };
     let err = run(&args, &mut |_| {}).unwrap_err().to_string();
     assert!(
@@ -169,6 +172,7 @@ fn bad_arguments_name_the_option() {
         balls: Some(vec![5000]),
         quick: true,
         font: None,
+        area_fractions: None,
     };
     assert!(run(&args, &mut |_| {})
         .unwrap_err()
@@ -180,4 +184,52 @@ fn bad_arguments_name_the_option() {
         .unwrap_err()
         .to_string()
         .contains("--seeds"));
+}
+
+#[test]
+fn the_quick_equation_of_state_meets_the_literature_within_its_error_bars() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ExperimentOptions {
+        which: Which::Eos,
+        out: dir.path().to_path_buf(),
+        seeds: None,
+        balls: None,
+        quick: true,
+        font: None,
+        area_fractions: None,
+    };
+    run(&args, &mut |_| {}).expect("the quick equation of state runs");
+    for file in ["eos.md", "eos.json", "eos.svg", "eos.png"] {
+        assert!(dir.path().join(file).is_file(), "{file} missing");
+    }
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("eos.json")).unwrap())
+            .unwrap();
+    let points = json["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2);
+    for p in points {
+        let (z, err) = (
+            p["z"]["mean"].as_f64().unwrap(),
+            p["z"]["error"].as_f64().unwrap(),
+        );
+        let liu = p["liu"].as_f64().unwrap();
+        // 1000 disks, 1000 collisions each: a standard error near 0.2 %; three of them
+        assert!(err > 0.0 && err < 0.005 * z, "{p}");
+        assert!((z - liu).abs() < 3.0 * err, "Z = {z} +- {err}, Liu {liu}");
+        // the virial and the collision rate give one Z
+        let rate = &p["z_from_rate"];
+        let both = (err.powi(2) + rate["error"].as_f64().unwrap().powi(2)).sqrt();
+        assert!(
+            (z - rate["mean"].as_f64().unwrap()).abs() < 3.0 * both,
+            "{p}"
+        );
+    }
+    let bad = ExperimentOptions {
+        area_fractions: Some(vec![0.8]),
+        ..args
+    };
+    assert!(run(&bad, &mut |_| {})
+        .unwrap_err()
+        .to_string()
+        .contains("--area-fractions"));
 }

@@ -526,15 +526,18 @@ def experiment(
     font: str | Path | None = None,
 ) -> dict[str, Any]:
     """Runs ``poolsim experiment``: ``"thesis"`` (chapter 6's tables 5-10 and chapter 7's
-    figures 17-18 beside the thesis' own numbers) or ``"reversal"`` (the reversal error against
-    the quitting time, 4.6-4.7), writing tables, figures and a report into ``out``. ``quick``
-    runs the reduced grid CI runs; ``seeds`` and ``balls`` (square numbers) set the thesis'
-    grid. Returns the data the run wrote (``results.json``, or ``reversal.json``)."""
+    figures 17-18 beside the thesis' own numbers), ``"reversal"`` (the reversal error against
+    the quitting time, 4.6-4.7) or ``"eos"`` (the hard-disk fluid's equation of state in a
+    periodic box beside the literature), writing tables, figures and a report into ``out``.
+    ``quick`` runs the reduced grid CI runs; ``seeds`` and ``balls`` (square numbers) set the
+    thesis' grid (for ``"eos"``, ``balls`` is one number of disks). Returns the data the run
+    wrote (``results.json``, ``reversal.json`` or ``eos.json``)."""
     _whole("seeds", seeds, 1)
     for b in balls or []:
         _whole("balls", b, 1)
     _native.experiment(which, Path(out), quick=quick, seeds=seeds,
                        balls=None if balls is None else list(balls),
                        font=None if font is None else Path(font))
-    name = "results.json" if which == "thesis" else "reversal.json"
+    name = {"thesis": "results.json", "reversal": "reversal.json", "eos": "eos.json"}.get(
+        which, "results.json")
     return json.loads((Path(out) / name).read_text())

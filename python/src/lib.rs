@@ -395,9 +395,10 @@ fn experiment(
     let which = match which {
         "thesis" => Which::Thesis,
         "reversal" => Which::Reversal,
+        "eos" => Which::Eos,
         other => {
             return Err(value_error(format!(
-                "which: thesis or reversal, got {other:?}"
+                "which: thesis, reversal or eos, got {other:?}"
             )))
         }
     };
@@ -408,6 +409,7 @@ fn experiment(
         balls,
         quick,
         font,
+        area_fractions: None,
     };
     py.detach(|| poolsim::experiment::run(&options, &mut |_| {}).map_err(value_error))
 }

@@ -12,6 +12,9 @@ pub enum ExperimentError {
     /// `--seeds` out of range.
     #[error("--seeds must be from 1 to 1000, got {0}")]
     Seeds(u64),
+    /// `--area-fractions` empty or outside the fluid's range.
+    #[error("--area-fractions: give one or more numbers between 0 and 0.7 (the fluid), got {0:?}")]
+    AreaFractions(Vec<f64>),
     /// `--balls` given an empty list.
     #[error("--balls needs at least one number of balls")]
     NoBalls,
@@ -24,6 +27,15 @@ pub enum ExperimentError {
          and quitting times)"
     )]
     ThesisOnly {
+        /// The option.
+        flag: &'static str,
+    },
+    /// `--balls` for the equation of state: one number of disks.
+    #[error("--balls: the equation of state takes one number of disks, from 16 on")]
+    EosBalls,
+    /// An option of the equation of state given to another experiment.
+    #[error("{flag}: only the equation of state (experiment eos) takes it")]
+    EosOnly {
         /// The option.
         flag: &'static str,
     },

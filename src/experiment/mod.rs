@@ -63,6 +63,8 @@ pub enum Which {
     Thesis,
     /// Thesis 4.6-4.7: the reversal error against the quitting time Q.
     Reversal,
+    /// The hard-disk fluid's equation of state in a periodic box, beside the literature.
+    Eos,
 }
 
 /// What `poolsim experiment` was asked for; options left `None` take the plan's defaults.
@@ -81,6 +83,8 @@ pub struct ExperimentOptions {
     pub quick: bool,
     /// TrueType font for the figures' text (default [`DEFAULT_FONT`]).
     pub font: Option<PathBuf>,
+    /// The equation of state's area fractions (default Liu's 0.3, 0.5, 0.6, 0.65).
+    pub area_fractions: Option<Vec<f64>>,
 }
 
 /// How far the experiment has come, for a progress display.
@@ -252,6 +256,30 @@ pub fn run(
     args: &ExperimentOptions,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<(), ExperimentError> {
+    if args.which == Which::Eos {
+        if args.seeds.is_some() {
+            return Err(ExperimentError::ThesisOnly { flag: "--seeds" });
+        }
+        let balls = match args.balls.as_deref() {
+            None => None,
+            Some([n]) if (16..=super::scenario::builtin::MAX_BALLS).contains(n) => Some(*n),
+            Some(_) => return Err(ExperimentError::EosBalls),
+        };
+        let plan = crate::eos_study::EosPlan::new(args.quick, balls, args.area_fractions.clone())?;
+        let font = args
+            .font
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(DEFAULT_FONT));
+        progress(Progress::Start(plan.area_fractions.len() as u64));
+        crate::eos_study::run(&args.out, &font, &plan, &|_| {})?;
+        progress(Progress::Finished);
+        return Ok(());
+    }
+    if args.area_fractions.is_some() {
+        return Err(ExperimentError::EosOnly {
+            flag: "--area-fractions",
+        });
+    }
     if args.which == Which::Reversal {
         if let Some(flag) = [
             ("--seeds", args.seeds.is_some()),
@@ -356,6 +384,7 @@ mod tests {
             balls: None,
             quick: false,
             font: None,
+            area_fractions: None,
         };
         let p = Plan::from_options(&a).unwrap();
         assert_eq!((p.balls.clone(), p.seeds), (vec![4, 16, 36, 64], 6));

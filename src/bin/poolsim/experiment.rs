@@ -14,12 +14,15 @@ pub enum WhichArg {
     Thesis,
     /// Thesis 4.6-4.7: the reversal error against the quitting time Q.
     Reversal,
+    /// The hard-disk fluid's equation of state in a periodic box, beside the literature.
+    Eos,
 }
 
 /// Arguments of `poolsim experiment`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct ExperimentArgs {
-    /// The experiment: `thesis` (chapter 6 tables 5-10 and chapter 7 figures 17-18).
+    /// The experiment: `thesis` (chapter 6 tables 5-10 and chapter 7 figures 17-18),
+    /// `reversal` (thesis 4.6-4.7) or `eos` (the hard-disk equation of state).
     #[arg(value_enum)]
     pub which: WhichArg,
     /// Directory to write the tables, figures, results.json and report.md into (created if
@@ -29,12 +32,17 @@ pub struct ExperimentArgs {
     /// Seeds per cell, 1..=S (default 6, as the thesis ran its non-sectored cases; 2 with --quick).
     #[arg(long)]
     pub seeds: Option<u64>,
-    /// Numbers of balls, comma separated (default 4,16,36,64; 4,16 with --quick).
+    /// Numbers of balls, comma separated (default 4,16,36,64; 4,16 with --quick); for eos, one
+    /// number of disks (default 10000; 1000 with --quick).
     #[arg(long, value_delimiter = ',')]
     pub balls: Option<Vec<usize>>,
-    /// A reduced grid for CI: 4 and 16 balls, 2 seeds, until 4.
+    /// A reduced grid for CI: 4 and 16 balls, 2 seeds, until 4 (eos: 1000 disks at 0.3 and
+    /// 0.5, shorter runs).
     #[arg(long)]
     pub quick: bool,
+    /// The equation of state's area fractions, comma separated (default 0.3,0.5,0.6,0.65).
+    #[arg(long = "area-fractions", value_delimiter = ',')]
+    pub area_fractions: Option<Vec<f64>>,
     /// TrueType font for the figures' text (default: DejaVu Sans from Debian's
     /// fonts-dejavu-core).
     #[arg(long)]
@@ -48,12 +56,14 @@ impl ExperimentArgs {
             which: match self.which {
                 WhichArg::Thesis => Which::Thesis,
                 WhichArg::Reversal => Which::Reversal,
+                WhichArg::Eos => Which::Eos,
             },
             out: self.out.clone(),
             seeds: self.seeds,
             balls: self.balls.clone(),
             quick: self.quick,
             font: self.font.clone(),
+            area_fractions: self.area_fractions.clone(),
         }
     }
 }
@@ -80,6 +90,7 @@ pub fn experiment(a: &ExperimentArgs) -> Result<(), Failure> {
     let report = match a.which {
         WhichArg::Thesis => "report.md",
         WhichArg::Reversal => "reversal.md",
+        WhichArg::Eos => "eos.md",
     };
     println!(
         "wrote {} (with its tables, figures and data beside it)",
