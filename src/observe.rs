@@ -77,6 +77,25 @@ pub struct Observed {
     pub z: Estimate,
     /// Force per unit length on the cushions (their momentum per unit time and length).
     pub pressure_walls: Estimate,
+    /// Each whole block's figures in time order: the time series the estimates average.
+    pub series: Vec<BlockFigures>,
+}
+
+/// One block's figures (see [`Observed`] for each).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BlockFigures {
+    /// The block's end.
+    pub end: f64,
+    /// The temperature.
+    pub kt: f64,
+    /// Ball–ball collisions per ball and unit time.
+    pub collision_rate: f64,
+    /// Pressure from the collision virial.
+    pub pressure: f64,
+    /// The compressibility factor.
+    pub z: f64,
+    /// Force per unit length on the cushions.
+    pub pressure_walls: f64,
 }
 
 /// Why blocks cannot be observed over a run: each message reads after the name of the setting
@@ -221,23 +240,38 @@ impl Observables {
     /// What the whole blocks came to.
     pub fn finish(mut self, until: f64) -> Observed {
         self.advance(until);
-        let (n, area) = (self.balls as f64, self.area);
-        let each = |f: &dyn Fn(&Block) -> f64| -> Estimate {
-            Estimate::of(&self.blocks.iter().map(f).collect::<Vec<_>>())
+        let (n, area, t) = (self.balls as f64, self.area, self.every);
+        let series: Vec<BlockFigures> = self
+            .blocks
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                let kt = b.kinetic_time / t / n;
+                BlockFigures {
+                    end: self.from + t * (k + 1) as f64,
+                    kt,
+                    collision_rate: 2.0 * b.collisions as f64 / (n * t),
+                    pressure: (n * kt + b.virial / (2.0 * t)) / area,
+                    z: 1.0 + b.virial / (2.0 * t * n * kt),
+                    pressure_walls: b.wall_impulse / (t * self.cushion_length),
+                }
+            })
+            .collect();
+        let each = |f: fn(&BlockFigures) -> f64| -> Estimate {
+            Estimate::of(&series.iter().map(f).collect::<Vec<_>>())
         };
-        let t = self.every;
-        let kt = |b: &Block| b.kinetic_time / t / n;
         Observed {
             from: self.from,
             every: self.every,
             blocks: self.blocks.len(),
             balls: self.balls,
             area,
-            kt: each(&kt),
-            collision_rate: each(&|b| 2.0 * b.collisions as f64 / (n * t)),
-            pressure: each(&|b| (n * kt(b) + b.virial / (2.0 * t)) / area),
-            z: each(&|b| 1.0 + b.virial / (2.0 * t * n * kt(b))),
-            pressure_walls: each(&|b| b.wall_impulse / (t * self.cushion_length)),
+            kt: each(|b| b.kt),
+            collision_rate: each(|b| b.collision_rate),
+            pressure: each(|b| b.pressure),
+            z: each(|b| b.z),
+            pressure_walls: each(|b| b.pressure_walls),
+            series,
         }
     }
 }
