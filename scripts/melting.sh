@@ -16,7 +16,9 @@ etas=${ETAS:-"0.698 0.702 0.706 0.710 0.714 0.718 0.722"}
 mkdir -p "$out"
 for eta in $etas; do
   for lattice in triangular square; do
-    timeout -s INT "$secs" "$bin" run disks --balls "$balls" --area-fraction "$eta" \
+    # --foreground: GNU timeout would otherwise signal its whole process group as well, and a
+    # second SIGINT ends poolsim at once, without its summary
+    timeout --foreground -s INT "$secs" "$bin" run disks --balls "$balls" --area-fraction "$eta" \
       --boundary periodic --lattice "$lattice" --until 1e9 --observe-every "${BLOCK:-20}" \
       --observe-from 0 --json >"$out/$eta-$lattice.json" 2>"$out/$eta-$lattice.err" &
   done
