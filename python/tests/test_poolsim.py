@@ -357,3 +357,20 @@ def test_in_a_periodic_box_displacements_grow_without_bound_and_samples_keep_ima
     # left when it reaches x = 10, the box's x = 0
     ev = poolsim.run(boxed).events
     assert len(ev) >= 1 and abs(ev["t"][0] - 5.0) < 1e-12
+
+
+def test_hexatic_order_tells_a_lattice_from_a_fluid_and_velocities_decorrelate():
+    from poolsim.analysis import hexatic_order, velocity_autocorrelation
+
+    lattice = poolsim.run("disks", balls=900, area_fraction=0.6, until=0.0, events=False,
+                          boundary="periodic")
+    psi, order = hexatic_order(lattice.final, lattice.table)
+    assert psi.shape == (900,) and order > 0.9, order
+    fluid = poolsim.run("disks", balls=900, area_fraction=0.4, until=40, events=False,
+                        boundary="periodic", sample_every=0.25)
+    _, melted = hexatic_order(fluid.final, fluid.table)
+    assert melted < 0.2, melted
+    t, c = velocity_autocorrelation(fluid.samples[40:])
+    assert t[0] == 0.0 and abs(c[0] - 1.0) < 1e-12
+    # a few mean free times on, the velocities have forgotten where they started
+    assert c[1] < 0.9 and abs(c[-20:]).max() < 0.1, c[:5]

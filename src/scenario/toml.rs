@@ -338,7 +338,28 @@ impl RawFile {
                 }
             })
             .collect();
-        let sectors = match &self.sectors {
+        let sectors = self.sectors()?;
+        let mut scenario = Scenario {
+            name: source.to_string(),
+            until: self
+                .run
+                .as_ref()
+                .map_or(DEFAULT_UNTIL, |r| opt(&r.until, DEFAULT_UNTIL)),
+            balls,
+            cushions,
+            pockets,
+            sectors,
+            periodic: None,
+        };
+        if let Some(rect) = &self.rect {
+            rect.apply(&mut scenario)?;
+        }
+        Ok(scenario)
+    }
+
+    /// The `[sectors]` table as a layout; only its shape can fail here.
+    fn sectors(&self) -> Result<Option<SectorSpec>, (Invalid, Option<Range<usize>>)> {
+        Ok(match &self.sectors {
             None => None,
             Some(s) => Some(match (&s.grid, &s.polygon) {
                 (Some(g), Some(_)) => {
@@ -381,23 +402,7 @@ impl RawFile {
                     ))
                 }
             }),
-        };
-        let mut scenario = Scenario {
-            name: source.to_string(),
-            until: self
-                .run
-                .as_ref()
-                .map_or(DEFAULT_UNTIL, |r| opt(&r.until, DEFAULT_UNTIL)),
-            balls,
-            cushions,
-            pockets,
-            sectors,
-            periodic: None,
-        };
-        if let Some(rect) = &self.rect {
-            rect.apply(&mut scenario)?;
-        }
-        Ok(scenario)
+        })
     }
 
     /// The span of a field named the way [`Scenario::validate`] names it (`ball[3].radius`,
