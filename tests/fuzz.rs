@@ -5,8 +5,10 @@
 //!
 //! The contract: nothing panics; a refused file gets one line naming it; a file that parses runs,
 //! or stops with one of the run's own errors; and the exact engines agree with the event list to
-//! the bit. `POOLSIM_FUZZ_CASES` sets the number of files (default 48; CI runs more). Inputs that
-//! once crashed are kept as tests in `scenario_parsing.rs`.
+//! the bit. `POOLSIM_FUZZ_CASES` sets the number of files (default 48; CI runs more), and
+//! `POOLSIM_FUZZ_SEED` the random seed (a number, or `random` for a new one each run; default a
+//! fixed seed, so that a run of the tests gives the same answer every time). Inputs that once
+//! crashed are kept as tests in `scenario_parsing.rs`.
 
 use pdes_kernel::time_warp::TwConfig;
 use poolsim::engine::{Ignore, RunError};
@@ -221,6 +223,16 @@ fn run_everywhere(s: &Scenario, text: &str, closed: bool) -> Result<(), TestCase
     Ok(())
 }
 
+/// The seed the files are drawn with.
+fn seed() -> proptest::test_runner::RngSeed {
+    use proptest::test_runner::RngSeed;
+    match std::env::var("POOLSIM_FUZZ_SEED").ok().as_deref() {
+        None => RngSeed::Fixed(20_261_128),
+        Some("random") => RngSeed::Random,
+        Some(n) => n.parse().map_or(RngSeed::Random, RngSeed::Fixed),
+    }
+}
+
 fn cases() -> u32 {
     std::env::var("POOLSIM_FUZZ_CASES")
         .ok()
@@ -231,6 +243,7 @@ fn cases() -> u32 {
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: cases(),
+        rng_seed: seed(),
         failure_persistence: None,
         ..ProptestConfig::default()
     })]

@@ -49,13 +49,18 @@ const GAS: [&str; 6] = ["gas", "--balls", "400", "--seed", "5", "--json"];
 /// A run stopped at half time, and taken up twice: once on to three quarters, then again from
 /// the half-time checkpoint on to the end, which must cut the trace back to half time.
 fn check_engine(engine: &[&str]) {
+    check_scenario(&GAS, engine);
+}
+
+/// [`check_engine`] on `scenario` (its name and parameters, and `--json`).
+fn check_scenario(scenario: &[&str], engine: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let whole = ok(
         d,
         &args(&[
             &["run"],
-            &GAS,
+            scenario,
             engine,
             &[
                 "--until",
@@ -71,7 +76,7 @@ fn check_engine(engine: &[&str]) {
         d,
         &args(&[
             &["run"],
-            &GAS,
+            scenario,
             engine,
             &[
                 "--until",
@@ -126,6 +131,21 @@ fn check_engine(engine: &[&str]) {
 #[test]
 fn the_event_list_taken_up_ends_as_one_run() {
     check_engine(&["--engine", "event-list"]);
+}
+
+#[test]
+fn a_periodic_box_taken_up_ends_as_one_run() {
+    let disks = [
+        "disks",
+        "--balls",
+        "400",
+        "--seed",
+        "5",
+        "--boundary",
+        "periodic",
+        "--json",
+    ];
+    check_scenario(&disks, &["--engine", "event-list"]);
 }
 
 #[test]

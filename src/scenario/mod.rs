@@ -606,17 +606,25 @@ impl Scenario {
                     ),
                 ));
             }
-            let through_cushion = self.cushions.iter().position(|c| {
-                let l = c.to - c.from;
-                let len = l.norm();
-                let along = (p - c.from).dot(l) / len;
-                let into = (p - c.from).dot(l.perp_cw()) / len;
-                along >= 0.0 && along <= len && into.abs() < b.radius * (1.0 - 1e-9)
-            });
+            // a ball overlaps a cushion anywhere along it, its ends included, and a pocket's
+            // corner: moving on, it would be inside the one or the other
+            let reach2 = (b.radius * (1.0 - 1e-9)).powi(2);
+            let through_cushion = self
+                .cushions
+                .iter()
+                .position(|c| crate::geometry::segment_distance2(p, c.from, c.to) < reach2);
             if let Some(c) = through_cushion {
                 return Err(invalid(
                     field(),
                     format!("Ball-{} overlaps Cushion-{} at t = 0", i + 1, c + 1),
+                ));
+            }
+            let on_corner = (0..self.corner_count())
+                .position(|k| (self.corner_position(k) - p).norm2() < reach2);
+            if let Some(k) = on_corner {
+                return Err(invalid(
+                    field(),
+                    format!("Ball-{} overlaps Corner-{} at t = 0", i + 1, k + 1),
                 ));
             }
         }
