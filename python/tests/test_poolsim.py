@@ -273,8 +273,11 @@ def test_the_thesis_experiment_runs_from_python(tmp_path):
     results = poolsim.experiment("thesis", tmp_path / "thesis", quick=True)
     assert (tmp_path / "thesis" / "report.md").exists()
     assert results["plan"]["balls"] == [4, 16]
-    with pytest.raises(ValueError, match="which: thesis or reversal"):
+    with pytest.raises(ValueError, match="which: thesis, reversal or eos"):
         poolsim.experiment("nope", tmp_path / "x")
+    eos = poolsim.experiment("eos", tmp_path / "eos", quick=True)
+    assert [p["area_fraction"] for p in eos["points"]] == [0.3, 0.5]
+    assert (tmp_path / "eos" / "eos.svg").exists()
 
 
 def test_a_disk_fluid_starts_at_its_temperature_with_no_momentum():
