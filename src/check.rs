@@ -232,10 +232,15 @@ impl World for Snapshot<'_> {
         let x = Self::x(self.table, &self.balls[i as usize], self.t);
         // in a periodic box the neighbours near one side include those near the other
         let sides = match &self.table.period {
-            Some(b) => vec![-b.size.x, 0.0, b.size.x],
-            None => vec![0.0],
+            Some(b) => [-b.size.x, 0.0, b.size.x],
+            None => [0.0; 3],
         };
-        for side in sides {
+        let sides = if self.table.period.is_some() {
+            &sides[..]
+        } else {
+            &sides[..1]
+        };
+        for &side in sides {
             let x = x + side;
             let from = self.by_x.partition_point(|e| e.0 < x - self.reach);
             for &(xj, j) in &self.by_x[from..] {

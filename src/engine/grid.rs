@@ -609,20 +609,18 @@ impl Grid {
                 }
             }
             None if c < self.nx * self.ny => {
+                out[0] = c;
+                if self.layouts.periodic {
+                    let (xs, ys) = self.wrapped_around(c);
+                    for (k, &(dx, dy)) in AROUND.iter().enumerate() {
+                        out[k + 1] = ys[(dy + 1) as usize] * self.nx + xs[(dx + 1) as usize];
+                    }
+                    return out;
+                }
                 let (cx, cy) = (i64::from(c % self.nx), i64::from(c / self.nx));
                 let (nx, ny) = (i64::from(self.nx), i64::from(self.ny));
-                out[0] = c;
-                // one side over at most: a comparison, not a division, wraps it round
-                let wrap = |v: i64, n: i64| match v {
-                    _ if v < 0 => v + n,
-                    _ if v >= n => v - n,
-                    _ => v,
-                };
                 for (k, &(dx, dy)) in AROUND.iter().enumerate() {
-                    let (mut x, mut y) = (cx + i64::from(dx), cy + i64::from(dy));
-                    if self.layouts.periodic {
-                        (x, y) = (wrap(x, nx), wrap(y, ny));
-                    }
+                    let (x, y) = (cx + i64::from(dx), cy + i64::from(dy));
                     if (0..nx).contains(&x) && (0..ny).contains(&y) {
                         out[k + 1] = (y * nx + x) as u32;
                     }
