@@ -2,7 +2,8 @@
 //! "Object-Oriented Simulation of Pool Ball Motion" (M.S. thesis, UCLA, 1984).
 //!
 //! The crate is a few rooms, each with one job:
-//! - [`geometry`] and [`physics`]: pure functions of trajectories (thesis ch. 3);
+//! - [`geometry`] and [`physics`]: pure functions of trajectories (thesis ch. 3); [`growth`]:
+//!   the same for disks that grow (compression);
 //! - [`scenario`]: tables and balls from TOML or built-in generators, validated once;
 //! - [`vtime`]: the lexicographic virtual time that orders simultaneous events exactly;
 //! - [`model`]: the pool objects as models of the [`pdes_kernel`] crate, a generic
@@ -17,12 +18,14 @@ pub mod analytic;
 pub mod bench;
 pub mod check;
 pub mod checkpoint;
+pub mod compress;
 pub mod engine;
 #[cfg(feature = "pictures")]
 pub mod eos_study;
 #[cfg(feature = "pictures")]
 pub mod experiment;
 pub mod geometry;
+pub mod growth;
 pub mod memory;
 pub mod model;
 pub mod observe;

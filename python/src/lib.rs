@@ -66,9 +66,10 @@ impl Ask {
             None => None,
             Some("triangular") => Some(Lattice::Triangular),
             Some("square") => Some(Lattice::Square),
+            Some("random") => Some(Lattice::Random),
             Some(other) => {
                 return Err(value_error(format!(
-                    "lattice: triangular or square, got {other:?}"
+                    "lattice: triangular, square or random, got {other:?}"
                 )))
             }
         };

@@ -67,6 +67,8 @@ pub enum Lattice {
     /// Rows half a spacing apart in turn, `√3/2` spacings above each other: each site has six
     /// neighbours (the densest packing of equal disks).
     Triangular,
+    /// No lattice: random sequential addition (up to about 0.5 of the area; compress beyond).
+    Random,
 }
 
 /// A binary mixture: a fraction of the balls large, by a diameter ratio.

@@ -11,6 +11,7 @@ use super::builtin::{
     allow, bad, boxed, radius_param, triangular_rows, Boundary, Lattice, Mixture, Params, AREA,
     BALLS, BOUNDARY, DEFAULT_SEED, GAP, LATTICE, MIXTURE, RADIUS, SEED, TEMPERATURE,
 };
+use super::random_sites::{random_sites, TRIES_PER_DISK};
 use super::{BallSpec, Invalid, Scenario};
 use crate::geometry::Vec2;
 use rand::seq::SliceRandom;
@@ -82,25 +83,33 @@ pub fn disks(p: &Params) -> Result<Scenario, Invalid> {
     let rmax = radii.iter().copied().fold(0.0, f64::max);
     let lattice = p.lattice.unwrap_or(Lattice::Triangular);
     let boundary = p.boundary.unwrap_or_default();
-    let sites = match boundary {
-        Boundary::Walled => sites(lattice, n, rmax, side),
-        Boundary::Periodic => periodic_sites(lattice, n, rmax, side),
-    };
-    let sites = sites.map_err(|need| {
+    let sites = match (lattice, boundary) {
+        (Lattice::Random, _) => {
+            let periodic = boundary == Boundary::Periodic;
+            let placed = random_sites(&radii, side, periodic, GAP, &mut rng).map_err(|placed| {
+                bad(
+                    AREA,
+                    format!(
+                        "{phi} is too dense for random sequential addition: {placed} of {n} disks \
+                         placed before one found no room in {TRIES_PER_DISK} tries (equal disks \
+                         jam near 0.547); start sparser and compress (poolsim compress)"
+                    ),
+                )
+            })?;
+            Ok(placed)
+        }
+        (_, Boundary::Walled) => sites(lattice == Lattice::Square, n, rmax, side),
+        (_, Boundary::Periodic) => periodic_sites(lattice == Lattice::Square, n, rmax, side),
+    }
+    .map_err(|need| {
         let most = (covered / (need * need) * 1e6).floor() / 1e6;
+        let (kind, walls) = (
+            if lattice == Lattice::Square { "square" } else { "triangular" },
+            if boundary == Boundary::Walled { "walled" } else { "periodic" },
+        );
         bad(
             AREA,
-            format!(
-                "{phi} is too dense for {n} disks on a {} lattice in a {} box: at most {most}",
-                match lattice {
-                    Lattice::Square => "square",
-                    Lattice::Triangular => "triangular",
-                },
-                match boundary {
-                    Boundary::Walled => "walled",
-                    Boundary::Periodic => "periodic",
-                }
-            ),
+            format!("{phi} is too dense for {n} disks on a {kind} lattice in a {walls} box: at most {most}"),
         )
     })?;
     let velocities = maxwell_boltzmann(n, kt, &mut rng);
@@ -147,18 +156,15 @@ fn radii(p: &Params, n: usize, rng: &mut ChaCha8Rng) -> Result<Vec<f64>, Invalid
 /// Sites for `n` disks of radius at most `r` in the box `[0, side]²`, row by row from the
 /// bottom, each at least a radius (and a hair) from the walls and two from the others. `Err`
 /// holds the smallest side that would take them.
-fn sites(lattice: Lattice, n: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
+fn sites(square: bool, n: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
     let d = 2.0 * r * (1.0 + GAP);
     // columns per row, the rows' pitch and shift, and the extent in spacings
-    let (m, pitch, shift, need) = match lattice {
-        Lattice::Square => {
-            let k = (n as f64).sqrt().ceil() as usize;
-            (k, 1.0, 0.0, k as f64)
-        }
-        Lattice::Triangular => {
-            let (m, need) = triangular_rows(n);
-            (m, 3f64.sqrt() / 2.0, 0.5, need)
-        }
+    let (m, pitch, shift, need) = if square {
+        let k = (n as f64).sqrt().ceil() as usize;
+        (k, 1.0, 0.0, k as f64)
+    } else {
+        let (m, need) = triangular_rows(n);
+        (m, 3f64.sqrt() / 2.0, 0.5, need)
     };
     let spacing = side / need;
     if spacing < d {
@@ -182,24 +188,28 @@ fn sites(lattice: Lattice, n: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64
 /// a lattice that tiles the box, `m` columns by `k` rows (for the triangular lattice `k` even
 /// and every other row shifted by half a column, the shape nearest the regular lattice). `Err`
 /// holds the smallest side that would take them.
-fn periodic_sites(lattice: Lattice, n: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
+fn periodic_sites(square: bool, n: usize, r: f64, side: f64) -> Result<Vec<Vec2>, f64> {
     let d = 2.0 * r * (1.0 + GAP);
     // the closest two sites, in box sides, of `m` columns by `k` rows
     let closest = |m: usize, k: usize| -> f64 {
         let (ax, ay) = (1.0 / m as f64, 1.0 / k as f64);
-        match lattice {
-            Lattice::Square => ax.min(ay),
-            Lattice::Triangular => ax.min((0.25 * ax * ax + ay * ay).sqrt()).min(2.0 * ay),
+        if square {
+            ax.min(ay)
+        } else {
+            ax.min((0.25 * ax * ax + ay * ay).sqrt()).min(2.0 * ay)
         }
     };
-    let rows = |m: usize| match lattice {
-        Lattice::Square => n.div_ceil(m),
-        Lattice::Triangular => n.div_ceil(m).next_multiple_of(2),
+    let rows = |m: usize| {
+        if square {
+            n.div_ceil(m)
+        } else {
+            n.div_ceil(m).next_multiple_of(2)
+        }
     };
     let root = (n as f64).sqrt().ceil() as usize;
-    let (m, k) = match lattice {
-        Lattice::Square => (root, root),
-        Lattice::Triangular => (root / 2..=2 * root + 2)
+    let (m, k) = match square {
+        true => (root, root),
+        false => (root / 2..=2 * root + 2)
             .filter(|&m| m >= 1)
             .map(|m| (m, rows(m)))
             .max_by(|a, b| closest(a.0, a.1).total_cmp(&closest(b.0, b.1)))
@@ -209,10 +219,7 @@ fn periodic_sites(lattice: Lattice, n: usize, r: f64, side: f64) -> Result<Vec<V
     if spacing < d {
         return Err(side * d / spacing);
     }
-    let shift = match lattice {
-        Lattice::Square => 0.0,
-        Lattice::Triangular => 0.5,
-    };
+    let shift = if square { 0.0 } else { 0.5 };
     let (ax, ay) = (side / m as f64, side / k as f64);
     Ok((0..n)
         .map(|s| {

@@ -8,6 +8,7 @@
 pub mod builtin;
 mod disks;
 mod periodic;
+pub mod random_sites;
 pub mod toml;
 
 pub use periodic::MIN_SIDE_DIAMETERS;

@@ -25,7 +25,8 @@ pub struct GenArgs {
     /// Speeds are drawn uniform in [0, V) (gas, reversal).
     #[arg(long = "speed-max")]
     pub speed_max: Option<f64>,
-    /// The lattice the disks start on: triangular or square (disks).
+    /// The lattice the disks start on: triangular, square, or random (sequential addition)
+    /// (disks).
     #[arg(long, value_enum)]
     pub lattice: Option<LatticeArg>,
     /// Maxwell-Boltzmann velocities with this kinetic energy per disk, zero total momentum
@@ -56,6 +57,8 @@ pub enum LatticeArg {
     Triangular,
     /// Four neighbours per site.
     Square,
+    /// No lattice: random sequential addition (up to about 0.5 of the area).
+    Random,
 }
 
 /// Parses `--mixture F:Q`.
@@ -85,6 +88,7 @@ impl GenArgs {
             lattice: self.lattice.map(|l| match l {
                 LatticeArg::Triangular => builtin::Lattice::Triangular,
                 LatticeArg::Square => builtin::Lattice::Square,
+                LatticeArg::Random => builtin::Lattice::Random,
             }),
             temperature: self.temperature,
             mixture: self.mixture,

@@ -5,6 +5,7 @@
 mod bench;
 mod checkpoints;
 mod common;
+mod compress;
 mod experiment;
 mod model;
 mod phold;
@@ -87,6 +88,9 @@ enum Command {
     /// checkpoint's own end by default), continuing its trace; any engine but the time-step
     /// one ends in the same state.
     Resume(Box<RunArgs>),
+    /// Grow the disks of a periodic box (Lubachevsky-Stillinger) to a target area fraction or
+    /// until they jam, and write the packing as a final state.
+    Compress(Box<compress::CompressArgs>),
 }
 
 /// Lets a closed pipe end the process quietly, as it does every Unix filter (`poolsim bench |
@@ -166,6 +170,7 @@ fn main() -> ExitCode {
         Command::Resume(a) => checkpoints::resume(a),
         Command::Model(a) => model(a),
         Command::Experiment(a) => experiment::experiment(a),
+        Command::Compress(a) => compress::run_compress(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -31,6 +31,7 @@ use super::{
     RunError, Span, Table, World,
 };
 use crate::geometry::{PeriodicBox, Trajectory, Vec2};
+use crate::growth::Growth;
 use crate::physics::{self, Contact};
 use crate::scenario::{BallSpec, Scenario};
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
@@ -39,6 +40,7 @@ use pdes_kernel::Interrupt;
 use smallvec::SmallVec;
 use std::cmp::Ordering;
 
+mod growing;
 mod periodic;
 
 /// The pair code that marks a ball leaving its cell: sorts after every physical event of its
@@ -221,6 +223,10 @@ pub struct EventList {
     unwrap: Vec<(f64, f64)>,
     /// In a periodic box, the inverses of its sides (zero in a walled box).
     inverse_size: Vec2,
+    /// How the disks grow, in a compression (the `growing` submodule); `None`: they do not.
+    growth: Option<Growth>,
+    /// The time the grid's cells stop holding the grown disks: runs end there at the latest.
+    grown_until: f64,
 }
 
 /// Options of the event-list engine.
@@ -244,12 +250,19 @@ impl Default for Options {
 impl EventList {
     /// Sets up the engine at time 0 for a validated scenario and predicts every ball's first event.
     pub fn new(s: &Scenario, opts: Options) -> EventList {
+        EventList::build(s, opts, None)
+    }
+
+    /// [`EventList::new`], with the disks growing by `grow.0` until `grow.1` (the grid's cells
+    /// are laid out for the disks grown by then).
+    fn build(s: &Scenario, opts: Options, grow: Option<(Growth, f64)>) -> EventList {
         let table = Table::new(s);
         let period = table.period;
         let start = opts.span.start;
         let balls = BallState::initial(s, start);
         let n = balls.len();
-        let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+        let rmax = balls.iter().map(|b| b.radius).fold(0.0, f64::max)
+            * grow.map_or(1.0, |(g, until)| g.factor(until));
         let wrap = |p: Vec2| period.map_or(p, |b| b.wrap(p));
         let centres: Vec<_> = balls.iter().map(|b| wrap(b.position(start))).collect();
         let mut grid = Grid::new(
@@ -310,6 +323,8 @@ impl EventList {
             } else {
                 Vec::new()
             },
+            growth: grow.map(|(g, _)| g),
+            grown_until: grow.map_or(f64::INFINITY, |(_, until)| until),
         };
         e.look_in = e.look_interval();
         // First predictions go into a provisional calendar; the real one's bucket width comes
@@ -425,6 +440,10 @@ impl EventList {
         if self.period.is_none() {
             for &j in near {
                 self.offer_ball(i, b, j, best);
+            }
+        } else if let Some(growth) = self.growth {
+            for (&j, &shift) in near.iter().zip(shifts) {
+                self.offer_grown(i, b, j, shift, growth, best);
             }
         } else {
             for (&j, &shift) in near.iter().zip(shifts) {
@@ -637,7 +656,7 @@ impl EventList {
         obs: &mut dyn Observer,
     ) -> Result<Outcome, RunError> {
         let mut counts = EventCounts::default();
-        let mut until = until;
+        let mut until = until.min(self.grown_until);
         loop {
             if counts.total() >= max_events {
                 until = self.now;
@@ -748,14 +767,16 @@ impl EventList {
             // the image of b that touches a
             pb = pb + period.shift(period.images(pa - pb));
         }
-        let (va, vb) = physics::ball_ball_velocities(
-            pa,
-            sa.traj.velocity,
-            self.own[a as usize].mass,
-            pb,
-            sb.traj.velocity,
-            self.own[b as usize].mass,
-        );
+        let (ma, mb) = (self.own[a as usize].mass, self.own[b as usize].mass);
+        let (va, vb) = match self.growth {
+            None => {
+                physics::ball_ball_velocities(pa, sa.traj.velocity, ma, pb, sb.traj.velocity, mb)
+            }
+            Some(g) => g.velocities(
+                (pa, sa.traj.velocity, ma, sa.radius),
+                (pb, sb.traj.velocity, mb, sb.radius),
+            ),
+        };
         self.set_velocity(a, key, va);
         self.set_velocity(b, key, vb);
         let (mut near_a, mut shifts_a) = (Near::new(), Shifts::new());
@@ -886,6 +907,7 @@ impl EventList {
         (0..self.slots.len() as u32)
             .map(|i| {
                 let mut b = self.ball(i);
+                b.radius = self.radius_at(i, t);
                 if b.pocket.is_none() {
                     b.traj = Trajectory {
                         position: self.period.map_or(b.traj.at(t), |p| p.wrap(b.traj.at(t))),
@@ -912,7 +934,7 @@ impl World for EventList {
         let s = &self.slots[i as usize];
         BallState {
             traj: s.traj,
-            radius: s.radius,
+            radius: self.radius_at(i, self.now),
             mass: self.own[i as usize].mass,
             pocket: self.pocket[i as usize],
         }
