@@ -12,7 +12,9 @@
 //! `Z = (1 + η² / 8) / (1 − η)²`.
 
 use crate::engine::RunError;
-use crate::experiment::{create_dir, draw_error, register_font, write, write_png, ExperimentError};
+use crate::experiment::{
+    create_dir, draw_error, register_font, write, write_svg_png, ExperimentError, Figure,
+};
 use crate::observe::{Estimate, Observables};
 use crate::run::{execute, EngineKind, RunConfig};
 use crate::scenario::builtin::{build, Boundary, Params};
@@ -196,18 +198,7 @@ pub fn run(
         serde_json::to_string_pretty(&json)?.as_bytes(),
     )?;
     register_font(font)?;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
-        draw(&root, &points)?;
-    }
-    write(&dir.join("eos.svg"), svg.as_bytes())?;
-    let mut buf = vec![255u8; (W * H * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
-        draw(&root, &points)?;
-    }
-    write_png(&dir.join("eos.png"), &buf, W, H)?;
+    write_svg_png(dir, "eos", (W, H), &EosFigure(&points))?;
     Ok(points)
 }
 
@@ -245,6 +236,21 @@ fn report(plan: &EosPlan, points: &[EosPoint]) -> String {
         ));
     }
     md
+}
+
+/// The figure of `eos.svg` and `eos.png`.
+struct EosFigure<'a>(&'a [EosPoint]);
+
+impl Figure for EosFigure<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, plotters::coord::Shift>,
+    ) -> Result<(), ExperimentError>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw(root, self.0)
+    }
 }
 
 const W: u32 = 900;

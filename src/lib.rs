@@ -26,6 +26,7 @@ pub mod eos_study;
 pub mod experiment;
 pub mod geometry;
 pub mod growth;
+pub mod jamming_study;
 pub mod memory;
 pub mod model;
 pub mod observe;

@@ -4,7 +4,9 @@
 //! The setup is the thesis' (400 × 400 table, a 4 × 4 array of radius-30 balls, speeds uniform in
 //! [0, 100)); seed 3 gives over 100 collisions from −3 to 3, as the thesis reports.
 
-use crate::experiment::{create_dir, draw_error, register_font, write, write_png, ExperimentError};
+use crate::experiment::{
+    create_dir, draw_error, register_font, write, write_svg_png, ExperimentError, Figure,
+};
 use crate::model::pool::NvDelay;
 use crate::run::{reverse, EngineKind, FixedNews, ReversalReport, SectorChoice};
 use crate::scenario::builtin::{build, Params};
@@ -90,18 +92,22 @@ pub fn run(dir: &Path, font: &Path, quick: bool) -> Result<(), ExperimentError> 
         .filter(|r| r.engine == "event-list")
         .map(|r| (r.quit, r.max_position_error.max(1e-16)))
         .collect();
-    let mut svg = String::new();
+    write_svg_png(dir, "reversal_error", (W, H), &ErrorFigure(&points))
+}
+
+/// The figure of `reversal_error.svg` and `reversal_error.png`: the error against Q.
+struct ErrorFigure<'a>(&'a [(f64, f64)]);
+
+impl Figure for ErrorFigure<'_> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, plotters::coord::Shift>,
+    ) -> Result<(), ExperimentError>
+    where
+        DB::ErrorType: 'static,
     {
-        let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
-        draw(&root, &points)?;
+        draw(root, self.0)
     }
-    write(&dir.join("reversal_error.svg"), svg.as_bytes())?;
-    let mut buf = vec![255u8; (W * H * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
-        draw(&root, &points)?;
-    }
-    write_png(&dir.join("reversal_error.png"), &buf, W, H)
 }
 
 fn draw<DB: DrawingBackend>(

@@ -174,9 +174,13 @@ fn a_mixture_jams_near_random_close_packing() {
         .fold(Vec2::ZERO, |a, b| a + b.mass * b.velocity);
     assert!(p.norm() < 1e-9 * n, "momentum {p:?}");
     // the size ratio is kept
-    let (small, large) = done.scenario.balls.iter().fold((f64::MAX, 0.0f64), |(s, l), b| {
-        (s.min(b.radius), l.max(b.radius))
-    });
+    let (small, large) = done
+        .scenario
+        .balls
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(s, l), b| {
+            (s.min(b.radius), l.max(b.radius))
+        });
     assert!((large / small - 1.4).abs() < 1e-12);
     // the pressure rose cycle after cycle to the threshold, and the area fraction with it
     let zs: Vec<f64> = done.cycles.iter().map(|c| c.z).collect();
@@ -198,7 +202,11 @@ fn a_compression_stops_at_its_target_and_the_packing_runs_on() {
     };
     let done = compress(&s, &cfg, None, &mut |_| {}).expect("the compression");
     assert_eq!(done.ending, Ending::Target);
-    assert!((done.area_fraction() - 0.7).abs() < 1e-9, "{}", done.area_fraction());
+    assert!(
+        (done.area_fraction() - 0.7).abs() < 1e-9,
+        "{}",
+        done.area_fraction()
+    );
     assert!(smallest_gap(&done.scenario) > -1e-9);
     // the same start, the same packing, bit for bit
     let again = compress(&s, &cfg, None, &mut |_| {}).expect("the compression");
@@ -306,14 +314,25 @@ fn the_command_writes_a_packing_that_starts_a_run() {
         cycles.to_str().unwrap(),
         "--json",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(summary["ending"], "target");
     assert!((summary["area_fraction"].as_f64().unwrap() - 0.75).abs() < 1e-9);
     let lines = std::fs::read_to_string(&cycles).unwrap();
-    assert_eq!(lines.lines().count() as u64, summary["cycles"].as_u64().unwrap());
+    assert_eq!(
+        lines.lines().count() as u64,
+        summary["cycles"].as_u64().unwrap()
+    );
     let run = poolsim(&["run", packing.to_str().unwrap(), "--until", "1", "--check"]);
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     // bad input: one line, exit 2
     for args in [
         vec!["compress", "--boundary", "walled"],

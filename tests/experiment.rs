@@ -31,6 +31,7 @@ fn quick(dir: &Path) {
         quick: true,
         font: None,
         area_fractions: None,
+        rates: None,
     };
     run(&args, &mut |_| {}).expect("the quick experiment runs");
 }
@@ -152,6 +153,7 @@ fn a_missing_font_is_a_clear_error_after_the_tables() {
         quick: true,
         font: Some(dir.path().join("no-such-font.ttf")),
         area_fractions: None,
+        rates: None,
     };
     let err = run(&args, &mut |_| {}).unwrap_err().to_string();
     assert!(
@@ -173,6 +175,7 @@ fn bad_arguments_name_the_option() {
         quick: true,
         font: None,
         area_fractions: None,
+        rates: None,
     };
     assert!(run(&args, &mut |_| {})
         .unwrap_err()
@@ -197,6 +200,7 @@ fn the_quick_equation_of_state_meets_the_literature_within_its_error_bars() {
         quick: true,
         font: None,
         area_fractions: None,
+        rates: None,
     };
     run(&args, &mut |_| {}).expect("the quick equation of state runs");
     for file in ["eos.md", "eos.json", "eos.svg", "eos.png"] {
@@ -232,4 +236,61 @@ fn the_quick_equation_of_state_meets_the_literature_within_its_error_bars() {
         .unwrap_err()
         .to_string()
         .contains("--area-fractions"));
+}
+
+#[test]
+fn the_quick_jamming_study_packs_denser_the_slower_it_grows() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ExperimentOptions {
+        which: Which::Jamming,
+        out: dir.path().to_path_buf(),
+        seeds: None,
+        balls: None,
+        quick: true,
+        font: None,
+        area_fractions: None,
+        rates: None,
+    };
+    run(&args, &mut |_| {}).expect("the quick jamming study runs");
+    for file in ["jamming.md", "jamming.json", "jamming.svg", "jamming.png"] {
+        assert!(dir.path().join(file).is_file(), "{file} missing");
+    }
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("jamming.json")).unwrap())
+            .unwrap();
+    let points = json["points"].as_array().unwrap();
+    let phi: Vec<(f64, f64)> = points
+        .iter()
+        .map(|p| {
+            (
+                p["area_fraction"]["mean"].as_f64().unwrap(),
+                p["area_fraction"]["error"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(phi.len(), 2);
+    // 200 disks jam below 0.83 at rate 0.1 and above 0.84 at 0.01 (0.822 and 0.846 measured)
+    assert!((0.80..0.835).contains(&phi[0].0), "{phi:?}");
+    assert!((0.835..0.86).contains(&phi[1].0), "{phi:?}");
+    assert!(phi[1].0 - phi[0].0 > 3.0 * (phi[0].1 + phi[1].1), "{phi:?}");
+    assert_eq!(json["runs"].as_array().unwrap().len(), 4);
+    for (rates, flag) in [(vec![0.0], "--rates"), (vec![], "--rates")] {
+        let bad = ExperimentOptions {
+            rates: Some(rates),
+            ..args.clone()
+        };
+        assert!(run(&bad, &mut |_| {})
+            .unwrap_err()
+            .to_string()
+            .contains(flag));
+    }
+    let eos = ExperimentOptions {
+        which: Which::Eos,
+        rates: Some(vec![0.1]),
+        ..args
+    };
+    assert!(run(&eos, &mut |_| {})
+        .unwrap_err()
+        .to_string()
+        .contains("only the jamming study"));
 }

@@ -35,7 +35,9 @@ __all__ = [
     "Result",
     "Scenario",
     "State",
+    "Packing",
     "builtins",
+    "compress",
     "experiment",
     "phold",
     "run",
@@ -357,6 +359,75 @@ def run(
     )
 
 
+@dataclass(frozen=True)
+class Packing:
+    """What :func:`compress` produced: why it ended (``ending``: ``"target"`` or
+    ``"jammed"``), the compression's duration ``t``, the packing ``final`` (a :class:`State` at
+    t = 0, velocities at kT = 1) in its periodic ``table``, and ``cycles``, a dict of arrays with
+    one entry per cycle: ``t`` (its end), ``area_fraction``, ``z`` (its reduced pressure),
+    ``kt`` (its mean temperature before the thermostat) and ``collisions``."""
+
+    ending: str
+    t: float
+    final: State
+    table: Table
+    cycles: dict[str, np.ndarray]
+
+    @property
+    def area_fraction(self) -> float:
+        """The fraction of the box the disks cover."""
+        (x0, y0), (x1, y1) = self.table.lo, self.table.hi
+        return float(np.pi * np.sum(self.final.radius ** 2) / ((x1 - x0) * (y1 - y0)))
+
+    @property
+    def z(self) -> float:
+        """The last cycle's reduced pressure P A / (N kT)."""
+        return float(self.cycles["z"][-1]) if len(self.cycles["z"]) else float("nan")
+
+    def scenario(self, until: float = 10.0) -> Scenario:
+        """The packing as a scenario in its periodic box, to :func:`run` on to ``until``."""
+        (x0, y0), (x1, y1) = self.table.lo, self.table.hi
+        return Scenario.box(x1 - x0, y1 - y0, self.final.position - np.array([x0, y0]),
+                            self.final.velocity, radius=self.final.radius,
+                            mass=self.final.mass, until=until, periodic=True)
+
+
+def compress(
+    scenario: str | Path | Scenario = "disks",
+    *,
+    rate: float = 0.01,
+    target: float | None = None,
+    max_pressure: float = 1e12,
+    cycle_collisions: float = 2.0,
+    check: bool = False,
+    balls: int | None = None,
+    seed: int | None = None,
+    area_fraction: float | None = None,
+    radius: float | None = None,
+    lattice: str | None = None,
+    temperature: float | None = None,
+    mixture: tuple[float, float] | None = None,
+    boundary: str | None = None,
+) -> Packing:
+    """Grows the disks of a periodic box (Lubachevsky-Stillinger, ``poolsim compress``) at
+    ``rate`` (the smallest diameter gained per unit time, kT = m = 1) to the area fraction
+    ``target``, or until a cycle's reduced pressure passes ``max_pressure`` (jammed), rescaling
+    the velocities to kT = 1 every ``cycle_collisions`` collisions per disk. The ``disks``
+    start is by default random (``lattice="random"``), periodic, at area fraction 0.2; the
+    other keywords are :func:`run`'s. Runs with Python's lock released."""
+    if scenario == "disks":
+        boundary = boundary or "periodic"
+        lattice = lattice or "random"
+        area_fraction = area_fraction if area_fraction is not None else 0.2
+    spec, ask = _ask(scenario, None, "event-list", None, None, None, check, None, False,
+                     dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
+                          lattice=lattice, temperature=temperature, mixture=mixture,
+                          boundary=boundary))
+    d = _native.compress(spec, ask, rate, target, max_pressure, cycle_collisions)
+    return Packing(ending=d["ending"], t=d["t"], final=State._of(d["final"]),
+                   table=Table._of(d["table"]), cycles=dict(d["cycles"]))
+
+
 class EventStream:
     """A run's events in chunks (structured arrays of :data:`EVENT_DTYPE`), as it goes.
 
@@ -527,17 +598,20 @@ def experiment(
 ) -> dict[str, Any]:
     """Runs ``poolsim experiment``: ``"thesis"`` (chapter 6's tables 5-10 and chapter 7's
     figures 17-18 beside the thesis' own numbers), ``"reversal"`` (the reversal error against
-    the quitting time, 4.6-4.7) or ``"eos"`` (the hard-disk fluid's equation of state in a
-    periodic box beside the literature), writing tables, figures and a report into ``out``.
-    ``quick`` runs the reduced grid CI runs; ``seeds`` and ``balls`` (square numbers) set the
-    thesis' grid (for ``"eos"``, ``balls`` is one number of disks). Returns the data the run
-    wrote (``results.json``, ``reversal.json`` or ``eos.json``)."""
+    the quitting time, 4.6-4.7), ``"eos"`` (the hard-disk fluid's equation of state in a
+    periodic box beside the literature) or ``"jamming"`` (the jammed area fraction of a binary
+    disk mixture against the compression rate), writing tables, figures and a report into
+    ``out``. ``quick`` runs the reduced grid CI runs; ``seeds`` and ``balls`` (square numbers)
+    set the thesis' grid (for ``"eos"`` and ``"jamming"``, ``balls`` is one number of disks).
+    Returns the data the run wrote (``results.json``, ``reversal.json``, ``eos.json`` or
+    ``jamming.json``)."""
     _whole("seeds", seeds, 1)
     for b in balls or []:
         _whole("balls", b, 1)
     _native.experiment(which, Path(out), quick=quick, seeds=seeds,
                        balls=None if balls is None else list(balls),
                        font=None if font is None else Path(font))
-    name = {"thesis": "results.json", "reversal": "reversal.json", "eos": "eos.json"}.get(
+    name = {"thesis": "results.json", "reversal": "reversal.json", "eos": "eos.json",
+            "jamming": "jamming.json"}.get(
         which, "results.json")
     return json.loads((Path(out) / name).read_text())

@@ -4,6 +4,7 @@
 //! documented API; this module's signatures are its contract with them.
 
 mod collect;
+mod compress;
 mod interop;
 mod stream;
 
@@ -397,9 +398,10 @@ fn experiment(
         "thesis" => Which::Thesis,
         "reversal" => Which::Reversal,
         "eos" => Which::Eos,
+        "jamming" => Which::Jamming,
         other => {
             return Err(value_error(format!(
-                "which: thesis, reversal or eos, got {other:?}"
+                "which: thesis, reversal, eos or jamming, got {other:?}"
             )))
         }
     };
@@ -411,6 +413,7 @@ fn experiment(
         quick,
         font,
         area_fractions: None,
+        rates: None,
     };
     py.detach(|| poolsim::experiment::run(&options, &mut |_| {}).map_err(value_error))
 }
@@ -423,6 +426,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(builtins, m)?)?;
     m.add_function(wrap_pyfunction!(phold, m)?)?;
     m.add_function(wrap_pyfunction!(experiment, m)?)?;
+    m.add_function(wrap_pyfunction!(compress::compress, m)?)?;
     m.add_function(wrap_pyfunction!(stream::stream, m)?)?;
     m.add_class::<stream::Stream>()?;
     m.add_function(wrap_pyfunction!(interop::write_xyz, m)?)?;

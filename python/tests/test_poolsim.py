@@ -273,7 +273,7 @@ def test_the_thesis_experiment_runs_from_python(tmp_path):
     results = poolsim.experiment("thesis", tmp_path / "thesis", quick=True)
     assert (tmp_path / "thesis" / "report.md").exists()
     assert results["plan"]["balls"] == [4, 16]
-    with pytest.raises(ValueError, match="which: thesis, reversal or eos"):
+    with pytest.raises(ValueError, match="which: thesis, reversal, eos or jamming"):
         poolsim.experiment("nope", tmp_path / "x")
     eos = poolsim.experiment("eos", tmp_path / "eos", quick=True)
     assert [p["area_fraction"] for p in eos["points"]] == [0.3, 0.5]
@@ -377,3 +377,20 @@ def test_hexatic_order_tells_a_lattice_from_a_fluid_and_velocities_decorrelate()
     assert t[0] == 0.0 and abs(c[0] - 1.0) < 1e-12
     # a few mean free times on, the velocities have forgotten where they started
     assert c[1] < 0.9 and abs(c[-20:]).max() < 0.1, c[:5]
+
+
+def test_a_compression_jams_a_mixture_and_its_packing_runs_on():
+    p = poolsim.compress(balls=150, mixture=(0.5, 1.4), rate=0.1, check=True)
+    assert p.ending == "jammed"
+    assert 0.80 < p.area_fraction < 0.86
+    assert p.z >= 1e12
+    assert np.all(np.diff(p.cycles["area_fraction"]) > 0)
+    assert np.isclose(np.mean(0.5 * p.final.mass * np.sum(p.final.velocity ** 2, axis=1)), 1.0)
+    q = poolsim.compress(balls=150, mixture=(0.5, 1.4), rate=0.1, target=0.7)
+    assert q.ending == "target" and abs(q.area_fraction - 0.7) < 1e-9
+    r = poolsim.run(q.scenario(until=2.0), check=True)
+    assert r["events"]["ball-ball"] > 100
+    with pytest.raises(ValueError, match="periodic box"):
+        poolsim.compress(boundary="walled")
+    with pytest.raises(ValueError, match="--target"):
+        poolsim.compress(target=0.1)

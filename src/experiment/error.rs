@@ -33,6 +33,18 @@ pub enum ExperimentError {
     /// `--balls` for the equation of state: one number of disks.
     #[error("--balls: the equation of state takes one number of disks, from 16 on")]
     EosBalls,
+    /// `--balls` for the jamming study: one number of disks.
+    #[error("--balls: the jamming study takes one number of disks, from 16 on")]
+    JammingBalls,
+    /// `--rates` empty or not all positive.
+    #[error("--rates: give one or more positive growth rates, got {0:?}")]
+    Rates(Vec<f64>),
+    /// An option of the jamming study given to another experiment.
+    #[error("{flag}: only the jamming study (experiment jamming) takes it")]
+    JammingOnly {
+        /// The option.
+        flag: &'static str,
+    },
     /// An option of the equation of state given to another experiment.
     #[error("{flag}: only the equation of state (experiment eos) takes it")]
     EosOnly {

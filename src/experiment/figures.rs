@@ -497,6 +497,38 @@ pub(super) fn write_figure(dir: &Path, eq: u32, ms: &[Measured]) -> Result<(), E
     write_png(&dir.join(format!("{stem}.png")), &buf, W, H)
 }
 
+/// A figure that draws itself on any of plotters' backends.
+pub(crate) trait Figure {
+    /// Draws the figure on `root`.
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+    ) -> Result<(), ExperimentError>
+    where
+        DB::ErrorType: 'static;
+}
+
+/// Writes `figure` as `stem.svg` and `stem.png`, `w` × `h` pixels, into `dir`.
+pub(crate) fn write_svg_png(
+    dir: &Path,
+    stem: &str,
+    (w, h): (u32, u32),
+    figure: &impl Figure,
+) -> Result<(), ExperimentError> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
+        figure.draw(&root)?;
+    }
+    write(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        figure.draw(&root)?;
+    }
+    write_png(&dir.join(format!("{stem}.png")), &buf, w, h)
+}
+
 /// Encodes an RGB buffer of `w` × `h` pixels as a PNG file.
 pub(crate) fn write_png(path: &Path, buf: &[u8], w: u32, h: u32) -> Result<(), ExperimentError> {
     let mut png_bytes = Vec::new();

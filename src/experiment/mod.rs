@@ -36,7 +36,7 @@ mod thesis;
 
 pub use data::{PhysicsRecord, RunRecord, Stat};
 pub use error::ExperimentError;
-pub(crate) use figures::{draw_error, register_font, write_png};
+pub(crate) use figures::{draw_error, register_font, write_svg_png, Figure};
 
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -65,6 +65,8 @@ pub enum Which {
     Reversal,
     /// The hard-disk fluid's equation of state in a periodic box, beside the literature.
     Eos,
+    /// The jammed area fraction of a binary disk mixture against the compression rate.
+    Jamming,
 }
 
 /// What `poolsim experiment` was asked for; options left `None` take the plan's defaults.
@@ -85,6 +87,8 @@ pub struct ExperimentOptions {
     pub font: Option<PathBuf>,
     /// The equation of state's area fractions (default Liu's 0.3, 0.5, 0.6, 0.65).
     pub area_fractions: Option<Vec<f64>>,
+    /// The jamming study's growth rates (default 0.1, 0.03, 0.01, 0.003, 0.001).
+    pub rates: Option<Vec<f64>>,
 }
 
 /// How far the experiment has come, for a progress display.
@@ -241,6 +245,31 @@ pub(crate) fn write(path: &Path, bytes: &[u8]) -> Result<(), ExperimentError> {
     })
 }
 
+/// Runs `poolsim experiment jamming`: one number of disks (`--balls`), `--seeds` per rate.
+fn run_jamming(
+    args: &ExperimentOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(), ExperimentError> {
+    let balls = match args.balls.as_deref() {
+        None => None,
+        Some([n]) if (16..=super::scenario::builtin::MAX_BALLS).contains(n) => Some(*n),
+        Some(_) => return Err(ExperimentError::JammingBalls),
+    };
+    if let Some(s) = args.seeds.filter(|s| !(1..=1000).contains(s)) {
+        return Err(ExperimentError::Seeds(s));
+    }
+    let plan =
+        crate::jamming_study::JammingPlan::new(args.quick, balls, args.seeds, args.rates.clone())?;
+    let font = args
+        .font
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_FONT));
+    progress(Progress::Start(plan.rates.len() as u64 * plan.seeds));
+    crate::jamming_study::run(&args.out, &font, &plan)?;
+    progress(Progress::Finished);
+    Ok(())
+}
+
 /// Creates the directory `dir` and its parents, with an error naming it.
 pub(crate) fn create_dir(dir: &Path) -> Result<(), ExperimentError> {
     std::fs::create_dir_all(dir).map_err(|source| ExperimentError::CreateDir {
@@ -257,6 +286,9 @@ pub fn run(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<(), ExperimentError> {
     if args.which == Which::Eos {
+        if args.rates.is_some() {
+            return Err(ExperimentError::JammingOnly { flag: "--rates" });
+        }
         if args.seeds.is_some() {
             return Err(ExperimentError::ThesisOnly { flag: "--seeds" });
         }
@@ -279,6 +311,12 @@ pub fn run(
         return Err(ExperimentError::EosOnly {
             flag: "--area-fractions",
         });
+    }
+    if args.which == Which::Jamming {
+        return run_jamming(args, progress);
+    }
+    if args.rates.is_some() {
+        return Err(ExperimentError::JammingOnly { flag: "--rates" });
     }
     if args.which == Which::Reversal {
         if let Some(flag) = [
@@ -385,6 +423,7 @@ mod tests {
             quick: false,
             font: None,
             area_fractions: None,
+            rates: None,
         };
         let p = Plan::from_options(&a).unwrap();
         assert_eq!((p.balls.clone(), p.seeds), (vec![4, 16, 36, 64], 6));

@@ -29,7 +29,7 @@ const DISKS_UNTIL: f64 = 10.0;
 pub fn describe() -> String {
     format!(
         "a hard-disk fluid's start: {BALLS} {DISKS_BALLS} disks ({RADIUS} {DISKS_RADIUS}, mass 1) \
-         on a {LATTICE} triangular|square lattice in a square box ({BOUNDARY} walled by elastic \
+         on a {LATTICE} triangular|square|random lattice in a square box ({BOUNDARY} walled by elastic \
          cushions, or periodic) at {AREA} {DISKS_AREA}, Maxwell-Boltzmann velocities at \
          {TEMPERATURE} {DISKS_TEMPERATURE} with zero total momentum, {MIXTURE} F:Q for a \
          fraction F of large disks Q times as wide ({SEED} {DEFAULT_SEED}); until {DISKS_UNTIL}"
