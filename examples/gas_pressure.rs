@@ -61,6 +61,7 @@ fn main() {
             span: Default::default(),
             interrupt: None,
             checkpoint_every: None,
+            thermostat: None,
         },
         &mut Ignore,
     )
@@ -79,6 +80,7 @@ fn main() {
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(&settled, &cfg, &mut walls).expect("the gas runs");
 

@@ -43,6 +43,7 @@ fn main() {
             span: Default::default(),
             interrupt: None,
             checkpoint_every: None,
+            thermostat: None,
         };
         let mut pockets = Pockets::default();
         let report = execute(&table, &cfg, &mut pockets).expect("the shot runs");

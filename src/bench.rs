@@ -675,6 +675,7 @@ pub fn measure_time_warp(
             span: Default::default(),
             interrupt: None,
             checkpoint_every: None,
+            thermostat: None,
         };
         let report = execute(&scenario, &cfg, &mut Ignore)?;
         let s = &report.summary;

@@ -177,6 +177,15 @@ impl Observer for Checker {
         }
         Ok(())
     }
+
+    /// The kicked ball's energy is taken up (a run with a thermostat is checked as inelastic:
+    /// energy is not conserved).
+    fn on_kick(&mut self, ball: u32, _t: f64, world: &dyn World) -> Result<(), RunError> {
+        let e = ball_energy(&world.ball(ball));
+        self.total += e - self.energy[ball as usize];
+        self.energy[ball as usize] = e;
+        Ok(())
+    }
 }
 
 /// Balls at one time on a table, as a [`World`]; neighbours found by sorting on x.

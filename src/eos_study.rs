@@ -130,6 +130,7 @@ fn measure(plan: &EosPlan, eta: f64) -> Result<EosPoint, ExperimentError> {
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let mut o = Observables::over(&s, (0.0, until), Some(from), every)
         .map_err(|e| RunError::Input(e.to_string()))?;

@@ -40,4 +40,5 @@ pub mod run;
 pub mod samples;
 pub mod scenario;
 pub mod summary;
+pub mod thermostat;
 pub mod vtime;

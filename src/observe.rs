@@ -307,6 +307,14 @@ impl Observer for Observables {
         }
         Ok(())
     }
+
+    /// The thermostat's kick changes the kinetic energy, and no pressure: it is not a force
+    /// between the disks.
+    fn on_kick(&mut self, ball: u32, t: f64, world: &dyn World) -> Result<(), RunError> {
+        self.advance(t);
+        self.kick(ball, world);
+        Ok(())
+    }
 }
 
 #[cfg(test)]

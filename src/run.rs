@@ -149,6 +149,9 @@ pub struct RunConfig {
     /// start (and where an interrupt stops it, and at its end) and hands its observer a
     /// [`Checkpoint`]. Not on the time-step engine, whose state is its grid of steps.
     pub checkpoint_every: Option<f64>,
+    /// Andersen's thermostat (event-list engine only; not with checkpoints, which do not
+    /// carry its generator).
+    pub thermostat: Option<crate::thermostat::Thermostat>,
 }
 
 /// What a run produced.
@@ -210,6 +213,13 @@ impl Observer for Sinks<'_> {
     fn on_checkpoint(&mut self, checkpoint: Checkpoint) -> Result<(), RunError> {
         self.user.on_checkpoint(checkpoint)
     }
+
+    fn on_kick(&mut self, ball: u32, t: f64, world: &dyn World) -> Result<(), RunError> {
+        if let Some(c) = &mut self.checker {
+            c.on_kick(ball, t, world)?;
+        }
+        self.user.on_kick(ball, t, world)
+    }
 }
 
 /// Refuses a ball so fast that it crosses its own radius in less time than the run's clock can
@@ -241,10 +251,27 @@ pub fn build_engine(scenario: &Scenario, cfg: &RunConfig) -> Result<Box<dyn Engi
             cfg.engine.name()
         )));
     }
+    if let Some(t) = &cfg.thermostat {
+        t.check().map_err(RunError::Input)?;
+        if cfg.engine != EngineKind::EventList {
+            return Err(RunError::Input(format!(
+                "--thermostat: runs on the event-list engine only, not on {}",
+                cfg.engine.name()
+            )));
+        }
+        if cfg.checkpoint_every.is_some() {
+            return Err(RunError::Input(
+                "--thermostat: a checkpoint cannot carry the thermostat's generator; run \
+                 without --checkpoint"
+                    .into(),
+            ));
+        }
+    }
     Ok(match cfg.engine {
         EngineKind::EventList => {
             let opts = event_list::Options {
                 span: cfg.span,
+                thermostat: cfg.thermostat,
                 ..Default::default()
             };
             Box::new(EventList::new(scenario, opts))
@@ -333,7 +360,7 @@ pub fn execute(
     let table = Table::new(scenario);
     let checker = cfg
         .check
-        .then(|| Checker::new(&initial, table.is_elastic()));
+        .then(|| Checker::new(&initial, table.is_elastic() && cfg.thermostat.is_none()));
     let mut sinks = Sinks { checker, user: obs };
     let mut engine = build_engine(scenario, cfg)?;
     if let Some(i) = &cfg.interrupt {
@@ -528,6 +555,7 @@ pub fn reverse(
         },
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let mut forward = Forward(0);
     let report = execute(scenario, &cfg, &mut forward)?;

@@ -21,6 +21,10 @@ use std::cmp::Ordering;
 /// `(lower, higher)` tuples.
 pub type Pair = u64;
 
+/// The pair code of a kick of the thermostat (`crate::thermostat`): after every physical
+/// event of its instant (its instants are random, so it shares one with none in practice).
+pub const BATH: Pair = u64::MAX - 4;
+
 /// The pair code of a reversal of every ball (thesis 4.6): it runs after every physical event of
 /// its instant.
 pub const REVERSAL: Pair = u64::MAX - 3;

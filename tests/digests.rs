@@ -855,6 +855,7 @@ fn every_scenario_on_every_engine_ends_as_recorded() {
             span: Default::default(),
             interrupt: None,
             checkpoint_every: None,
+            thermostat: None,
         };
         let report = execute(&s, &cfg, &mut Ignore)
             .unwrap_or_else(|e| panic!("{name} on {engine_name}: {e}"));

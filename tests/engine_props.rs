@@ -119,6 +119,7 @@ fn engine_run(s: &Scenario, check: bool) -> (Vec<TraceLine>, Vec<BallState>) {
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.outcome.balls)

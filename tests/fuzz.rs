@@ -168,6 +168,7 @@ fn digest(s: &Scenario, engine: EngineKind, check: bool) -> Result<String, RunEr
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     execute(s, &cfg, &mut Ignore).map(|r| r.summary.final_state_digest)
 }

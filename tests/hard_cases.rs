@@ -23,6 +23,7 @@ fn run(s: &Scenario) -> (Vec<TraceLine>, Vec<BallState>) {
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.outcome.balls)

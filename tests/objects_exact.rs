@@ -102,6 +102,7 @@ fn delay_mode_loses_an_update_as_in_table_2() {
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(&s, &cfg, &mut poolsim::engine::Ignore).unwrap();
     let v: Vec<f64> = report
@@ -221,6 +222,7 @@ fn projector_frames_match_the_event_list() {
                 span,
                 interrupt: None,
                 checkpoint_every: None,
+                thermostat: None,
             };
             let mut frames = Frames::default();
             let report = execute(&s, &cfg, &mut frames).unwrap();

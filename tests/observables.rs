@@ -16,6 +16,7 @@ fn observe(s: &Scenario, engine: EngineKind, from: f64, every: f64) -> Observed 
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let mut o = Observables::new(s, 0.0, from, every);
     let report = execute(s, &cfg, &mut o).expect("the run");

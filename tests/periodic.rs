@@ -271,6 +271,7 @@ fn a_periodic_fluid_keeps_the_collision_identity() {
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let mut o = Observables::new(&s, 0.0, 10.0, 5.0);
     let report = execute(&s, &cfg, &mut o).expect("the run");

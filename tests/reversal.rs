@@ -92,6 +92,7 @@ fn a_pocketed_ball_comes_back_out_at_the_mirror_time() {
             },
             interrupt: None,
             checkpoint_every: None,
+            thermostat: None,
         };
         let mut rec = TraceRecorder::default();
         execute(&s, &cfg, &mut rec).unwrap();
@@ -128,6 +129,7 @@ fn forward_and_backward_events_mirror_each_other() {
         },
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let mut rec = TraceRecorder::default();
     execute(&s, &cfg, &mut rec).unwrap();

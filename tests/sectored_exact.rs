@@ -19,6 +19,7 @@ fn run(s: &Scenario, engine: EngineKind) -> (Vec<TraceLine>, serde_json::Value) 
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, serde_json::to_value(&report.summary).unwrap())

@@ -54,6 +54,7 @@ fn run(
         },
         interrupt: None,
         checkpoint_every: every,
+        thermostat: None,
     };
     let mut kept = Kept::default();
     let report = execute(s, &cfg, &mut kept).unwrap_or_else(|e| panic!("{}: {e}", s.name));

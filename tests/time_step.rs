@@ -49,6 +49,7 @@ fn run_traced(s: &Scenario, engine: EngineKind, until: f64) -> (Report, TraceRec
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let mut trace = TraceRecorder::default();
     let report = execute(s, &cfg, &mut trace).expect("the run completes");
@@ -63,6 +64,7 @@ fn run(s: &Scenario, engine: EngineKind, until: f64) -> Report {
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     execute(s, &cfg, &mut Ignore).expect("the run completes")
 }

@@ -22,6 +22,7 @@ fn run(s: &Scenario, engine: EngineKind) -> Run {
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     Run {
@@ -241,6 +242,7 @@ fn rolling_back_for_memory_beside_final_batches_stays_exact() {
             span: Default::default(),
             interrupt: None,
             checkpoint_every: None,
+            thermostat: None,
         };
         let mut rec = TraceRecorder::default();
         match execute(&s, &cfg, &mut rec) {
@@ -358,6 +360,7 @@ fn a_failing_sink_stops_every_worker_with_its_error() {
             span: Default::default(),
             interrupt: None,
             checkpoint_every: None,
+            thermostat: None,
         };
         let mut obs = FailAt(0);
         match execute(&s, &cfg, &mut obs) {
@@ -394,6 +397,7 @@ fn the_projectors_frames_are_the_sequential_ones() {
             },
             interrupt: None,
             checkpoint_every: None,
+            thermostat: None,
         };
         let mut obs = Frames::default();
         execute(&s, &cfg, &mut obs).unwrap();

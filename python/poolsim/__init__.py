@@ -305,6 +305,9 @@ def _ask(
         "temperature": params.get("temperature"),
         "mixture": params.get("mixture"),
         "boundary": params.get("boundary"),
+        "thermostat": params.get("thermostat"),
+        "thermostat_rate": params.get("thermostat_rate"),
+        "thermostat_seed": params.get("thermostat_seed"),
     }
     return spec, ask
 
@@ -331,6 +334,9 @@ def run(
     temperature: float | None = None,
     mixture: tuple[float, float] | None = None,
     boundary: str | None = None,
+    thermostat: float | None = None,
+    thermostat_rate: float | None = None,
+    thermostat_seed: int | None = None,
 ) -> Result:
     """Runs a scenario to ``until`` (default: the scenario's own end) and returns its results.
 
@@ -342,13 +348,17 @@ def run(
     of the disks Q times as wide) and ``boundary`` (``"walled"`` or ``"periodic"``) are the
     built-in generators' parameters (``builtins()`` says which each takes). ``observe_every`` (from ``observe_from``) adds the
     pressure, the compressibility factor ``z``, the temperature ``kt`` and the collision rate,
-    each a block mean with its standard error, to ``summary["observables"]``. The engine runs
+    each a block mean with its standard error, to ``summary["observables"]``. ``thermostat``
+    (a kT) adds Andersen's thermostat on the event list: ``thermostat_rate`` kicks per disk and
+    unit time (default 0.1) from the seed ``thermostat_seed`` (default 1). The engine runs
     with Python's lock released, so threads can run simulations side by side.
     """
     spec, ask = _ask(scenario, until, engine, dt, workers, sectors, check, sample_every, events,
                      dict(balls=balls, seed=seed, area_fraction=area_fraction, radius=radius,
                           speed_max=speed_max, lattice=lattice, temperature=temperature,
-                          mixture=mixture, boundary=boundary), (observe_every, observe_from))
+                          mixture=mixture, boundary=boundary, thermostat=thermostat,
+                          thermostat_rate=thermostat_rate, thermostat_seed=thermostat_seed),
+                     (observe_every, observe_from))
     d = _native.run(spec, ask)
     return Result(
         summary=json.loads(d["summary"]),

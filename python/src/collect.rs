@@ -164,6 +164,13 @@ impl Observer for Collected {
         }
     }
 
+    fn on_kick(&mut self, ball: u32, t: f64, world: &dyn World) -> Result<(), RunError> {
+        match &mut self.observables {
+            Some(o) => o.on_kick(ball, t, world),
+            None => Ok(()),
+        }
+    }
+
     fn reads_balls(&self) -> bool {
         self.observables.is_some()
     }

@@ -47,6 +47,9 @@ pub struct Ask {
     temperature: Option<f64>,
     mixture: Option<(f64, f64)>,
     boundary: Option<String>,
+    thermostat: Option<f64>,
+    thermostat_rate: Option<f64>,
+    thermostat_seed: Option<u64>,
 }
 
 impl Ask {
@@ -201,7 +204,33 @@ fn config_of(ask: &Ask, scenario: &Scenario) -> PyResult<RunConfig> {
         },
         interrupt: None,
         checkpoint_every: None,
+        thermostat: thermostat_of(ask)?,
     })
+}
+
+/// Andersen's thermostat, if `thermostat` asks for one (`thermostat_rate` default 0.1,
+/// `thermostat_seed` default 1).
+fn thermostat_of(ask: &Ask) -> PyResult<Option<poolsim::thermostat::Thermostat>> {
+    let Some(kt) = ask.thermostat else {
+        if ask.thermostat_rate.is_some() || ask.thermostat_seed.is_some() {
+            return Err(value_error(
+                "thermostat_rate, thermostat_seed: need thermostat=kT",
+            ));
+        }
+        return Ok(None);
+    };
+    let t = poolsim::thermostat::Thermostat {
+        kt,
+        rate: ask.thermostat_rate.unwrap_or(0.1),
+        seed: ask.thermostat_seed.unwrap_or(1),
+    };
+    t.check().map_err(|e| {
+        value_error(
+            e.replacen("--thermostat-rate", "thermostat_rate", 1)
+                .replacen("--thermostat", "thermostat", 1),
+        )
+    })?;
+    Ok(Some(t))
 }
 
 /// A flat vector of pairs as an `(n, 2)` array, without a copy.

@@ -291,7 +291,7 @@ def test_a_disk_fluid_starts_at_its_temperature_with_no_momentum():
     cli = cli_json("run", "disks", "--balls", "500", "--area-fraction", "0.5", "--temperature",
                    "2", "--mixture", "0.5:1.4", "--lattice", "square", "--until", "0")
     assert r.digest == cli["final_state_digest"]
-    with pytest.raises(ValueError, match="lattice: triangular or square"):
+    with pytest.raises(ValueError, match="lattice: triangular, square or random"):
         poolsim.run("disks", lattice="hexagonal")
     with pytest.raises(ValueError, match="too dense"):
         poolsim.run("disks", area_fraction=0.95)
@@ -394,3 +394,18 @@ def test_a_compression_jams_a_mixture_and_its_packing_runs_on():
         poolsim.compress(boundary="walled")
     with pytest.raises(ValueError, match="--target"):
         poolsim.compress(target=0.1)
+
+
+def test_a_thermostat_brings_a_hot_gas_to_its_temperature():
+    r = poolsim.run("disks", balls=400, area_fraction=0.3, boundary="periodic", temperature=20.0,
+                    until=60.0, thermostat=1.0, thermostat_rate=0.5, observe_every=5.0,
+                    observe_from=20.0, check=True)
+    kt = r["observables"]["kt"]
+    assert abs(kt["mean"] - 1.0) < 3 * kt["error"] + 0.02
+    same = poolsim.run("disks", balls=400, area_fraction=0.3, boundary="periodic",
+                       temperature=20.0, until=60.0, thermostat=1.0, thermostat_rate=0.5)
+    assert same.digest == r.digest
+    with pytest.raises(ValueError, match="thermostat: the temperature"):
+        poolsim.run("disks", thermostat=-1.0)
+    with pytest.raises(ValueError, match="event-list engine only"):
+        poolsim.run("gas", thermostat=1.0, engine="objects")

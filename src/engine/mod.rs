@@ -451,6 +451,12 @@ pub trait Observer {
     fn on_frame(&mut self, _frame: &Frame, _table: &Table) -> Result<(), RunError> {
         Ok(())
     }
+
+    /// Called after the thermostat gave `ball` a new velocity at `t`: not a physical event
+    /// (the trace does not list it), but observers that follow velocities take it up here.
+    fn on_kick(&mut self, _ball: u32, _t: f64, _world: &dyn World) -> Result<(), RunError> {
+        Ok(())
+    }
 }
 
 /// An observer that ignores everything.
@@ -477,6 +483,10 @@ impl<O: Observer + ?Sized> Observer for &mut O {
 
     fn on_frame(&mut self, frame: &Frame, table: &Table) -> Result<(), RunError> {
         (**self).on_frame(frame, table)
+    }
+
+    fn on_kick(&mut self, ball: u32, t: f64, world: &dyn World) -> Result<(), RunError> {
+        (**self).on_kick(ball, t, world)
     }
 
     fn on_checkpoint(&mut self, checkpoint: Checkpoint) -> Result<(), RunError> {

@@ -156,6 +156,7 @@ fn physics(
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(s, &cfg, &mut fp).map_err(|source| ExperimentError::Physics {
         balls: n,
@@ -201,6 +202,7 @@ fn objects(
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let fail = |source: RunError| ExperimentError::Objects {
         balls: n,

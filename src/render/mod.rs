@@ -484,6 +484,7 @@ pub fn record(scenario: &Scenario, cfg: &RenderConfig) -> Result<Recording, RunE
         },
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(scenario, &run, &mut rec)?;
     let chunks = chunked(scenario, cfg.engine, span, &times)?;

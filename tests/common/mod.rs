@@ -23,6 +23,7 @@ pub fn traced(s: &Scenario, engine: EngineKind, check: bool) -> (Vec<TraceLine>,
         span: Default::default(),
         interrupt: None,
         checkpoint_every: None,
+        thermostat: None,
     };
     let report = execute(s, &cfg, &mut rec).unwrap_or_else(|e| panic!("{}: {e}", s.name));
     (rec.lines, report.summary)

@@ -106,6 +106,16 @@ pub struct RunArgs {
     /// settle first.
     #[arg(long = "observe-from", allow_negative_numbers = true)]
     pub observe_from: Option<f64>,
+    /// Andersen's thermostat at this temperature kT: at random instants one disk at a time
+    /// takes a fresh Maxwell-Boltzmann velocity (event-list engine).
+    #[arg(long, allow_negative_numbers = true)]
+    pub thermostat: Option<f64>,
+    /// The thermostat's kicks per disk and unit time (default 0.1).
+    #[arg(long = "thermostat-rate", allow_negative_numbers = true)]
+    pub thermostat_rate: Option<f64>,
+    /// The seed of the thermostat's kicks (default 1).
+    #[arg(long = "thermostat-seed")]
+    pub thermostat_seed: Option<u64>,
 }
 
 impl RunArgs {
@@ -145,6 +155,9 @@ impl RunArgs {
             sample_every: None,
             observe_every: None,
             observe_from: None,
+            thermostat: None,
+            thermostat_rate: None,
+            thermostat_seed: None,
         }
     }
 }
@@ -390,6 +403,7 @@ fn config_of(
     let start = from.map_or(0.0, |c| c.t);
     Ok(RunConfig {
         checkpoint_every: checkpoint_every(a, &engine, start, until)?,
+        thermostat: thermostat(a)?,
         engine,
         until,
         check: a.check,
@@ -400,6 +414,24 @@ fn config_of(
         },
         interrupt: None,
     })
+}
+
+/// The thermostat `a` asks for: `--thermostat-rate` and `--thermostat-seed` need
+/// `--thermostat`.
+fn thermostat(a: &RunArgs) -> Result<Option<poolsim::thermostat::Thermostat>, Failure> {
+    let Some(kt) = a.thermostat else {
+        if a.thermostat_rate.is_some() || a.thermostat_seed.is_some() {
+            return Err(usage(
+                "--thermostat-rate and --thermostat-seed need --thermostat KT",
+            ));
+        }
+        return Ok(None);
+    };
+    Ok(Some(poolsim::thermostat::Thermostat {
+        kt,
+        rate: a.thermostat_rate.unwrap_or(0.1),
+        seed: a.thermostat_seed.unwrap_or(1),
+    }))
 }
 
 /// Runs `scenario` as `a` asks, from its start or from checkpoint `from`: the trace as it goes
@@ -642,6 +674,13 @@ impl Observer for Sinks<'_> {
             o.on_event(ev, world)?;
         }
         Ok(())
+    }
+
+    fn on_kick(&mut self, ball: u32, t: f64, world: &dyn World) -> Result<(), RunError> {
+        match &mut self.observables {
+            Some(o) => o.on_kick(ball, t, world),
+            None => Ok(()),
+        }
     }
 
     fn reads_balls(&self) -> bool {

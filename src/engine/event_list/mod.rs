@@ -34,12 +34,14 @@ use crate::geometry::{PeriodicBox, Trajectory, Vec2};
 use crate::growth::Growth;
 use crate::physics::{self, Contact};
 use crate::scenario::{BallSpec, Scenario};
+use crate::thermostat::{Bath, Thermostat};
 use crate::vtime::{pair, Key, Pair, DISPLAY, REVERSAL};
 use pdes_kernel::prefetch::{prefetch, prefetch_all};
 use pdes_kernel::Interrupt;
 use smallvec::SmallVec;
 use std::cmp::Ordering;
 
+mod bath;
 mod growing;
 mod periodic;
 
@@ -227,6 +229,8 @@ pub struct EventList {
     growth: Option<Growth>,
     /// The time the grid's cells stop holding the grown disks: runs end there at the latest.
     grown_until: f64,
+    /// The thermostat's kicks, if it has one.
+    bath: Option<Bath>,
 }
 
 /// Options of the event-list engine.
@@ -236,6 +240,8 @@ pub struct Options {
     pub cell_diameters: f64,
     /// Start time and reversal.
     pub span: Span,
+    /// Andersen's thermostat; `None`: the dynamics conserves energy (on elastic tables).
+    pub thermostat: Option<Thermostat>,
 }
 
 impl Default for Options {
@@ -243,6 +249,7 @@ impl Default for Options {
         Options {
             cell_diameters: 1.0,
             span: Span::default(),
+            thermostat: None,
         }
     }
 }
@@ -325,6 +332,7 @@ impl EventList {
             },
             growth: grow.map(|(g, _)| g),
             grown_until: grow.map_or(f64::INFINITY, |(_, until)| until),
+            bath: opts.thermostat.map(|t| Bath::new(t, n as u32, start)),
         };
         e.look_in = e.look_interval();
         // First predictions go into a provisional calendar; the real one's bucket width comes
@@ -714,6 +722,10 @@ impl EventList {
         until: f64,
         obs: &mut dyn Observer,
     ) -> Result<bool, RunError> {
+        if self.bath_first(first, until) {
+            self.kick(obs)?;
+            return Ok(true);
+        }
         if let Some(r) = &self.reversal {
             let before = first.is_none_or(|i| *r < self.own[i as usize].queued);
             if before && r.t <= until {
