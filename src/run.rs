@@ -362,13 +362,15 @@ pub fn execute(
         .check
         .then(|| Checker::new(&initial, table.is_elastic() && cfg.thermostat.is_none()));
     let mut sinks = Sinks { checker, user: obs };
+    let (e0, _) = energies(&initial);
+    // the engine holds the balls from here on: a copy less at the peak of memory
+    drop(initial);
     let mut engine = build_engine(scenario, cfg)?;
     if let Some(i) = &cfg.interrupt {
         engine.stop_on(i.clone());
     }
     // the engine built and its objects set up, before the first event
     let setup = start.elapsed().as_secs_f64();
-    let (e0, _) = energies(&initial);
     let outcome = if cfg.checkpoint_every.is_some() {
         run_with_checkpoints(engine.as_mut(), scenario, cfg, e0, &mut sinks)?
     } else {

@@ -335,6 +335,8 @@ impl EventList {
             bath: opts.thermostat.map(|t| Bath::new(t, n as u32, start)),
         };
         e.look_in = e.look_interval();
+        // the engine's own records hold the balls now
+        drop((balls, centres));
         // First predictions go into a provisional calendar; the real one's bucket width comes
         // from the mean time to each ball's first event (events then come about mean / n apart).
         for i in 0..n as u32 {
@@ -347,7 +349,11 @@ impl EventList {
             .filter(|t| t.is_finite())
             .collect();
         let mean = finite.iter().map(|t| t - start).sum::<f64>() / finite.len().max(1) as f64;
-        e.queue = Calendar::new(n, start, mean / finite.len().max(1) as f64);
+        let gap = mean / finite.len().max(1) as f64;
+        drop(finite);
+        // the provisional calendar goes before the real one comes
+        e.queue = Calendar::heap_only(start);
+        e.queue = Calendar::new(n, start, gap);
         for i in 0..n as u32 {
             e.own[i as usize].place = Place::NOWHERE;
             let (queue, mut balls) = e.calendar();
