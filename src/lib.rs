@@ -26,6 +26,7 @@ pub mod eos_study;
 pub mod experiment;
 pub mod geometry;
 pub mod growth;
+#[cfg(feature = "pictures")]
 pub mod jamming_study;
 pub mod memory;
 pub mod model;
@@ -39,6 +40,7 @@ pub mod reversal_study;
 pub mod run;
 pub mod samples;
 pub mod scenario;
+pub mod structure;
 pub mod summary;
 pub mod thermostat;
 pub mod vtime;

@@ -418,6 +418,7 @@ pub fn execute(
             .and_then(Interrupt::cause)
             .map(|cause| Interruption::new(outcome.t, cause)),
         observables: None,
+        structure: None,
     };
     Ok(Report {
         outcome,

@@ -45,6 +45,9 @@ pub struct RunSummary {
     /// Pressure, compressibility factor, temperature and collision rate, when observed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub observables: Option<crate::observe::Observed>,
+    /// g(r), the mean squared displacement and ψ6 at the sample times, when observed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub structure: Option<crate::structure::StructureFigures>,
 }
 
 /// An interrupted run: the time it stopped at, every event up to it done, and the cause.
@@ -284,6 +287,7 @@ mod tests {
             time_warp: None,
             interrupted: None,
             observables: None,
+            structure: None,
         };
         let text = serde_json::to_string(&s).unwrap();
         assert!(

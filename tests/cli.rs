@@ -1091,7 +1091,7 @@ fn samples_are_extended_xyz_that_reads_back() {
     for (bad, says) in [
         (
             vec!["--sample-every", "1"],
-            "--sample-every: only --samples takes samples",
+            "--sample-every: only --samples and --observe take samples",
         ),
         (
             vec!["--samples", &xyz, "--sample-every", "-1"],
@@ -1192,7 +1192,94 @@ fn run_observes_the_pressure_in_blocks_on_every_engine() {
     assert!(bad_usage(&["run", "gas", "--observe-every", "0"])
         .contains("--observe-every: must be a positive number"));
     assert!(bad_usage(&["run", "gas", "--observe-from", "1"])
-        .contains("--observe-from: needs --observe-every"));
+        .contains("--observe-from: needs --observe-every or --observe"));
     assert!(bad_usage(&["run", "gas", "--observe-every", "10"])
         .contains("--observe-from: the first block, from 0 to 10, must lie within the run"));
+}
+
+#[test]
+fn observe_gives_the_structure_at_the_sample_times() {
+    let out = poolsim(&[
+        "run",
+        "disks",
+        "--balls",
+        "1500",
+        "--area-fraction",
+        "0.5",
+        "--boundary",
+        "periodic",
+        "--until",
+        "30",
+        "--observe",
+        "gr,msd,psi6",
+        "--observe-from",
+        "10",
+        "--sample-every",
+        "2",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let st = &v["structure"];
+    let numbers = |x: &serde_json::Value| -> Vec<f64> {
+        x.as_array()
+            .unwrap()
+            .iter()
+            .map(|y| y.as_f64().unwrap())
+            .collect()
+    };
+    let (r, g) = (numbers(&st["gr"]["r"]), numbers(&st["gr"]["g"]));
+    assert_eq!(st["gr"]["samples"], 11);
+    // no pair closer than a diameter (2), the contact peak above 2, and g near 1 far out
+    for (&r, &g) in r.iter().zip(&g) {
+        if r < 1.95 {
+            assert_eq!(g, 0.0, "g({r}) = {g}");
+        }
+    }
+    let peak = g.iter().copied().fold(0.0, f64::max);
+    assert!(peak > 2.0 && peak < 4.0, "peak {peak}");
+    let tail: f64 = g[80..].iter().sum::<f64>() / 20.0;
+    assert!((tail - 1.0).abs() < 0.1, "g far out {tail}");
+    let (t, msd) = (numbers(&st["msd"]["t"]), numbers(&st["msd"]["value"]));
+    assert_eq!(t.len(), 11);
+    assert_eq!((t[0], msd[0]), (0.0, 0.0));
+    assert!(msd.windows(2).all(|w| w[1] > w[0]), "{msd:?}");
+    // the melted lattice has no hexatic order left
+    assert!(numbers(&st["psi6"]["value"]).iter().all(|&p| p < 0.1));
+    for (args, what) in [
+        (vec!["run", "gas", "--observe", "nope"], "--observe"),
+        (
+            vec![
+                "run",
+                "disks",
+                "--boundary",
+                "periodic",
+                "--observe",
+                "gr",
+                "--gr-max",
+                "1e9",
+            ],
+            "--gr-max",
+        ),
+        (vec!["run", "gas", "--gr-max", "3"], "--gr-max"),
+        (
+            vec![
+                "run",
+                "gas",
+                "--observe",
+                "gr",
+                "--engine",
+                "time-step",
+                "--dt",
+                "0.01",
+            ],
+            "--observe",
+        ),
+    ] {
+        assert!(bad_usage(&args).contains(what), "{args:?}");
+    }
 }

@@ -13,6 +13,7 @@ use poolsim::model::pool::NvDelay;
 use poolsim::output::FinalState;
 use poolsim::run::{execute, EngineKind, RunConfig};
 use poolsim::scenario::Scenario;
+use poolsim::structure::{Structure, Wanted};
 use poolsim::summary::{KineticEnergy, RunSummary};
 use std::io::Write;
 use std::path::PathBuf;
@@ -110,6 +111,15 @@ pub struct RunArgs {
     /// takes a fresh Maxwell-Boltzmann velocity (event-list engine).
     #[arg(long, allow_negative_numbers = true)]
     pub thermostat: Option<f64>,
+    /// Structure at the sample times (--sample-every), comma separated: gr (the pair
+    /// correlation function, averaged over the samples), msd (the mean squared displacement
+    /// since the first sample), psi6 (the hexatic order); from --observe-from on.
+    #[arg(long, value_delimiter = ',')]
+    pub observe: Option<Vec<String>>,
+    /// How far g(r) reaches (default: five of the largest diameters, at most half a periodic
+    /// box's shorter side).
+    #[arg(long = "gr-max", allow_negative_numbers = true)]
+    pub gr_max: Option<f64>,
     /// The thermostat's kicks per disk and unit time (default 0.1).
     #[arg(long = "thermostat-rate", allow_negative_numbers = true)]
     pub thermostat_rate: Option<f64>,
@@ -158,6 +168,8 @@ impl RunArgs {
             thermostat: None,
             thermostat_rate: None,
             thermostat_seed: None,
+            observe: None,
+            gr_max: None,
         }
     }
 }
@@ -337,21 +349,29 @@ pub fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure
             return Err(usage(format!("{flag}: only the time-warp engine takes it")));
         }
     }
-    if a.sample_every.is_some() && a.samples.is_none() {
-        return Err(usage("--sample-every: only --samples takes samples"));
-    }
-    if a.samples.is_some() && (sectored || matches!(engine, EngineKind::TimeStep { .. })) {
+    if a.sample_every.is_some() && a.samples.is_none() && a.observe.is_none() {
         return Err(usage(
-            "--samples: the event-list engine, and the objects and time-warp engines without \
-             sectors, take samples",
+            "--sample-every: only --samples and --observe take samples",
         ));
+    }
+    let sampling = [
+        ("--samples", a.samples.is_some()),
+        ("--observe", a.observe.is_some()),
+    ];
+    if let Some((flag, _)) = sampling.iter().find(|(_, given)| *given) {
+        if sectored || matches!(engine, EngineKind::TimeStep { .. }) {
+            return Err(usage(format!(
+                "{flag}: the event-list engine, and the objects and time-warp engines without \
+                 sectors, take samples"
+            )));
+        }
     }
     Ok(())
 }
 
 /// The time between samples that `--samples` asks for, checked (`None` without it).
 fn sample_every(a: &RunArgs, start: f64, until: f64) -> Result<Option<f64>, Failure> {
-    if a.samples.is_none() {
+    if a.samples.is_none() && wanted_structure(a)? == Wanted::default() {
         return Ok(None);
     }
     match a.sample_every {
@@ -473,6 +493,7 @@ pub fn run_from(
         None => None,
     };
     let mut observables = observables(a, scenario, &cfg)?;
+    let mut structure = structure(a, scenario)?;
     let report = {
         let mut sinks = Sinks {
             trace: trace.as_mut(),
@@ -480,6 +501,7 @@ pub fn run_from(
             saver: saver.as_ref(),
             samples: samples.as_mut(),
             observables: observables.as_mut(),
+            structure: structure.as_mut(),
         };
         execute(scenario, &cfg, &mut sinks)
     };
@@ -511,11 +533,42 @@ pub fn run_from(
         count_from(&mut report.summary, c);
     }
     report.summary.observables = observables.map(|o| o.finish(report.outcome.t));
+    report.summary.structure = structure.map(Structure::finish);
     if let Some(p) = &a.final_state {
         write_final_state(p, &report.outcome, scenario)?;
     }
     print_summary(a, &report.summary)?;
     interrupted(&interrupt, report.outcome.t)
+}
+
+/// The structural observables `--observe` names.
+fn wanted_structure(a: &RunArgs) -> Result<Wanted, Failure> {
+    a.observe
+        .as_deref()
+        .map_or(Ok(Wanted::default()), Wanted::parse)
+        .map_err(usage)
+}
+
+/// The structural observables `--observe` asks for, g(r) out to `--gr-max`.
+fn structure(a: &RunArgs, scenario: &Scenario) -> Result<Option<Structure>, Failure> {
+    let wanted = wanted_structure(a)?;
+    if wanted == Wanted::default() {
+        return match a.gr_max {
+            Some(_) => Err(usage("--gr-max: needs --observe gr")),
+            None => Ok(None),
+        };
+    }
+    let table = poolsim::engine::Table::new(scenario);
+    let rmax = scenario.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+    let size = table.hi - table.lo;
+    let reach = a.gr_max.unwrap_or_else(|| match table.period {
+        Some(_) => (10.0 * rmax).min(size.x.min(size.y) / 2.0),
+        None => 10.0 * rmax,
+    });
+    let from = a.observe_from.unwrap_or(f64::NEG_INFINITY);
+    Structure::new(wanted, &table, from, reach)
+        .map(Some)
+        .map_err(usage)
 }
 
 /// The observables `--observe-every` and `--observe-from` ask for, checked against the run.
@@ -526,8 +579,10 @@ fn observables(
 ) -> Result<Option<poolsim::observe::Observables>, Failure> {
     let Some(every) = a.observe_every else {
         return match a.observe_from {
-            Some(_) => Err(usage("--observe-from: needs --observe-every")),
-            None => Ok(None),
+            Some(_) if a.observe.is_none() => {
+                Err(usage("--observe-from: needs --observe-every or --observe"))
+            }
+            _ => Ok(None),
         };
     };
     let span = (cfg.span.start, cfg.until);
@@ -625,6 +680,7 @@ pub struct Sinks<'a> {
     pub saver: Option<&'a Saver>,
     pub samples: Option<&'a mut Samples>,
     pub observables: Option<&'a mut poolsim::observe::Observables>,
+    pub structure: Option<&'a mut Structure>,
 }
 
 /// The samples file: extended XYZ frames written as the run reaches each sample time. The first
@@ -702,7 +758,10 @@ impl Observer for Sinks<'_> {
         if let Some(s) = self.samples.as_deref_mut().filter(|s| s.failed.is_none()) {
             s.failed = poolsim::samples::write_frame(&mut s.out, frame, table).err();
         }
-        Ok(())
+        match self.structure.as_deref_mut() {
+            Some(s) => s.on_frame(frame, table),
+            None => Ok(()),
+        }
     }
 }
 
@@ -783,6 +842,9 @@ pub fn human_summary(s: &RunSummary) -> String {
             o.collision_rate.mean
         ));
     }
+    if let Some(st) = &s.structure {
+        lines.extend(structure_lines(st));
+    }
     if let Some(i) = &s.interrupted {
         lines.push(format!(
             "interrupted   by {} at t = {:?}, every event up to it done",
@@ -790,6 +852,37 @@ pub fn human_summary(s: &RunSummary) -> String {
         ));
     }
     lines.join("\n") + "\n"
+}
+
+/// The summary's lines for the structure: g's highest peak, the last MSD, the mean of ψ6.
+fn structure_lines(st: &poolsim::structure::StructureFigures) -> Vec<String> {
+    let mut lines = Vec::new();
+    if let Some(gr) = &st.gr {
+        let (k, g) = gr.g.iter().enumerate().fold(
+            (0, 0.0),
+            |best, (k, &g)| if g > best.1 { (k, g) } else { best },
+        );
+        lines.push(format!(
+            "g(r)          over {} samples: highest {g:.4} at r = {:.4}",
+            gr.samples,
+            gr.r.get(k).copied().unwrap_or(0.0)
+        ));
+    }
+    if let (Some(m), true) = (&st.msd, st.msd.as_ref().is_some_and(|m| !m.t.is_empty())) {
+        lines.push(format!(
+            "msd           {:.6e} after {:?}",
+            m.value[m.value.len() - 1],
+            m.t[m.t.len() - 1]
+        ));
+    }
+    if let Some(p) = st.psi6.as_ref().filter(|p| !p.value.is_empty()) {
+        let mean = p.value.iter().sum::<f64>() / p.value.len() as f64;
+        lines.push(format!(
+            "psi6          mean {mean:.4} over {} samples",
+            p.value.len()
+        ));
+    }
+    lines
 }
 
 /// Refuses a run whose estimated memory is more than it may take, before it allocates; says
