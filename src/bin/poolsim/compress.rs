@@ -42,6 +42,9 @@ pub struct CompressArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No progress line on stderr.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// The summary of a compression.
@@ -85,7 +88,14 @@ pub fn run_compress(a: &CompressArgs) -> Result<(), Failure> {
         None => None,
     };
     let mut write_failed = None;
+    let bar = progress_line(a.quiet);
     let mut on_cycle = |c: &Cycle| {
+        if let Some(b) = &bar {
+            b.set_message(format!(
+                "cycle at t = {:.4}: area fraction {:.6}, reduced pressure {:.3e}",
+                c.t, c.area_fraction, c.z
+            ));
+        }
         if let Some(w) = cycles_out.as_mut() {
             let line = serde_json::to_string(c).expect("plain data");
             if let Err(e) = writeln!(w, "{line}") {
@@ -98,6 +108,9 @@ pub fn run_compress(a: &CompressArgs) -> Result<(), Failure> {
     let clock = std::time::Instant::now();
     let done = compress(&start, &cfg, Some(&interrupt), &mut on_cycle).map_err(run_failure)?;
     let wall_s = clock.elapsed().as_secs_f64();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
     if let Some(mut w) = cycles_out {
         if let Err(e) = w.flush() {
             write_failed.get_or_insert(e);
@@ -112,6 +125,21 @@ pub fn run_compress(a: &CompressArgs) -> Result<(), Failure> {
     write_packing(&a.final_state, &done)?;
     print_summary(a, &done, wall_s)?;
     interrupted(&interrupt, done.t)
+}
+
+/// A spinner with the last cycle's figures on stderr, when it is a terminal and not `quiet`.
+fn progress_line(quiet: bool) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] compress: {msg}")
+            .expect("a valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    Some(bar)
 }
 
 /// Writes the packing as a final state at time 0 (the start of whatever runs from it).
