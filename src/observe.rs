@@ -229,8 +229,13 @@ impl Observables {
 
     /// Ball `i`'s change of momentum at this event, and its new velocity kept.
     fn kick(&mut self, i: u32, world: &dyn World) -> Vec2 {
+        self.kick_to(i, world.ball(i).velocity())
+    }
+
+    /// Ball `i`'s change of momentum to the velocity `after`, which is kept.
+    #[inline]
+    fn kick_to(&mut self, i: u32, after: Vec2) -> Vec2 {
         let k = i as usize;
-        let after = world.ball(i).velocity();
         let dp = self.mass[k] * (after - self.velocity[k]);
         self.kinetic += 0.5 * self.mass[k] * (after.norm2() - self.velocity[k].norm2());
         self.velocity[k] = after;
@@ -282,12 +287,11 @@ impl Observer for Observables {
         let counted = ev.t >= self.from;
         match ev.kind {
             EventKind::BallBall => {
-                let dp = self.kick(ev.a, world);
-                self.kick(ev.b, world);
-                let (pa, pb) = (
-                    world.ball(ev.a).position(ev.t),
-                    world.ball(ev.b).position(ev.t),
-                );
+                // each ball read once: its new velocity and its place at the contact
+                let (a, b) = (world.ball(ev.a), world.ball(ev.b));
+                let dp = self.kick_to(ev.a, a.velocity());
+                self.kick_to(ev.b, b.velocity());
+                let (pa, pb) = (a.position(ev.t), b.position(ev.t));
                 // from b to a, the nearest image in a periodic box
                 let r = world.table().separation(pb, pa);
                 if counted {
