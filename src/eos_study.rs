@@ -242,6 +242,11 @@ fn report(plan: &EosPlan, points: &[EosPoint]) -> String {
 /// The figure of `eos.svg` and `eos.png`.
 struct EosFigure<'a>(&'a [EosPoint]);
 
+const W: u32 = 900;
+const H: u32 = 800;
+
+/// Z against the area fraction (Henderson's curve, Liu's points, the measured ones with their
+/// error bars) above the measured points' deviation from Liu's in percent.
 impl Figure for EosFigure<'_> {
     fn draw<DB: DrawingBackend>(
         &self,
@@ -250,74 +255,60 @@ impl Figure for EosFigure<'_> {
     where
         DB::ErrorType: 'static,
     {
-        draw(root, self.0)
+        let points = self.0;
+        let e = draw_error("the equation-of-state plot");
+        root.fill(&WHITE).map_err(&e)?;
+        let (top, bottom) = root.split_vertically(H * 5 / 8);
+        let zmax = henderson(0.7) * 1.05;
+        let mut chart = ChartBuilder::on(&top)
+            .caption(
+                "Hard-disk fluid: Z against the area fraction",
+                ("sans-serif", 20),
+            )
+            .margin(15)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..0.72, 0.0..zmax)
+            .map_err(&e)?;
+        chart
+            .configure_mesh()
+            .x_desc("area fraction")
+            .y_desc("Z = PA / NkT")
+            .draw()
+            .map_err(&e)?;
+        let curve = (0..=140)
+            .map(|k| f64::from(k) * 0.005)
+            .map(|x| (x, henderson(x)));
+        chart
+            .draw_series(LineSeries::new(curve, BLACK.stroke_width(1)))
+            .map_err(&e)?
+            .label("Henderson (1975)")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+        chart
+            .draw_series(LIU.iter().map(|&p| Cross::new(p, 7, RED.stroke_width(2))))
+            .map_err(&e)?
+            .label("Liu (2020)")
+            .legend(|(x, y)| Cross::new((x + 10, y), 5, RED.stroke_width(2)));
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|p| Circle::new((p.area_fraction, p.z.mean), 4, BLUE.filled())),
+            )
+            .map_err(&e)?
+            .label("poolsim, periodic box")
+            .legend(|(x, y)| Circle::new((x + 10, y), 4, BLUE.filled()));
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE)
+            .border_style(BLACK)
+            .draw()
+            .map_err(&e)?;
+        draw_deviation(&bottom, points, &e)?;
+        root.present().map_err(&e)?;
+        Ok(())
     }
-}
-
-const W: u32 = 900;
-const H: u32 = 800;
-
-/// Z against the area fraction (Henderson's curve, Liu's points, the measured ones with their
-/// error bars) above the measured points' deviation from Liu's in percent.
-fn draw<DB: DrawingBackend>(
-    root: &DrawingArea<DB, plotters::coord::Shift>,
-    points: &[EosPoint],
-) -> Result<(), ExperimentError>
-where
-    DB::ErrorType: 'static,
-{
-    let e = draw_error("the equation-of-state plot");
-    root.fill(&WHITE).map_err(&e)?;
-    let (top, bottom) = root.split_vertically(H * 5 / 8);
-    let zmax = henderson(0.7) * 1.05;
-    let mut chart = ChartBuilder::on(&top)
-        .caption(
-            "Hard-disk fluid: Z against the area fraction",
-            ("sans-serif", 20),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..0.72, 0.0..zmax)
-        .map_err(&e)?;
-    chart
-        .configure_mesh()
-        .x_desc("area fraction")
-        .y_desc("Z = PA / NkT")
-        .draw()
-        .map_err(&e)?;
-    let curve = (0..=140)
-        .map(|k| f64::from(k) * 0.005)
-        .map(|x| (x, henderson(x)));
-    chart
-        .draw_series(LineSeries::new(curve, BLACK.stroke_width(1)))
-        .map_err(&e)?
-        .label("Henderson (1975)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
-    chart
-        .draw_series(LIU.iter().map(|&p| Cross::new(p, 7, RED.stroke_width(2))))
-        .map_err(&e)?
-        .label("Liu (2020)")
-        .legend(|(x, y)| Cross::new((x + 10, y), 5, RED.stroke_width(2)));
-    chart
-        .draw_series(
-            points
-                .iter()
-                .map(|p| Circle::new((p.area_fraction, p.z.mean), 4, BLUE.filled())),
-        )
-        .map_err(&e)?
-        .label("poolsim, periodic box")
-        .legend(|(x, y)| Circle::new((x + 10, y), 4, BLUE.filled()));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE)
-        .border_style(BLACK)
-        .draw()
-        .map_err(&e)?;
-    draw_deviation(&bottom, points, &e)?;
-    root.present().map_err(&e)?;
-    Ok(())
 }
 
 /// The measured points' deviation from Liu's, in percent, with their error bars.

@@ -232,6 +232,10 @@ fn report(plan: &JammingPlan, points: &[JammingPoint]) -> String {
 /// The figure of `jamming.svg` and `jamming.png`.
 struct JammingFigure<'a>(&'a [JammingPoint]);
 
+const W: u32 = 900;
+const H: u32 = 550;
+
+/// The jammed area fraction against the rate (logarithmic), with O'Hern's value.
 impl Figure for JammingFigure<'_> {
     fn draw<DB: DrawingBackend>(
         &self,
@@ -240,71 +244,58 @@ impl Figure for JammingFigure<'_> {
     where
         DB::ErrorType: 'static,
     {
-        draw(root, self.0)
+        let points = self.0;
+        let e = draw_error("the jamming plot");
+        root.fill(&WHITE).map_err(&e)?;
+        let lo = points.iter().map(|p| p.rate).fold(f64::INFINITY, f64::min) / 2.0;
+        let hi = points.iter().map(|p| p.rate).fold(0.0, f64::max) * 2.0;
+        let mut chart = ChartBuilder::on(root)
+            .caption(
+                "Binary disks (1:1.4): jammed area fraction against the growth rate",
+                ("sans-serif", 20),
+            )
+            .margin(15)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d((lo..hi).log_scale(), 0.80..0.86)
+            .map_err(&e)?;
+        chart
+            .configure_mesh()
+            .x_desc("growth rate (diameter per unit time, kT = m = 1)")
+            .y_desc("jammed area fraction")
+            .draw()
+            .map_err(&e)?;
+        chart
+            .draw_series(LineSeries::new(
+                [(lo, OHERN), (hi, OHERN)],
+                RED.stroke_width(1),
+            ))
+            .map_err(&e)?
+            .label("O'Hern et al. (2003)")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+        chart
+            .draw_series(points.iter().map(|p| {
+                let (y, s) = (p.area_fraction.mean, p.area_fraction.error);
+                PathElement::new(vec![(p.rate, y - s), (p.rate, y + s)], BLUE.stroke_width(2))
+            }))
+            .map_err(&e)?;
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|p| Circle::new((p.rate, p.area_fraction.mean), 4, BLUE.filled())),
+            )
+            .map_err(&e)?
+            .label("poolsim compress")
+            .legend(|(x, y)| Circle::new((x + 10, y), 4, BLUE.filled()));
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerLeft)
+            .background_style(WHITE)
+            .border_style(BLACK)
+            .draw()
+            .map_err(&e)?;
+        root.present().map_err(&e)?;
+        Ok(())
     }
-}
-
-const W: u32 = 900;
-const H: u32 = 550;
-
-/// The jammed area fraction against the rate (logarithmic), with O'Hern's value.
-fn draw<DB: DrawingBackend>(
-    root: &DrawingArea<DB, plotters::coord::Shift>,
-    points: &[JammingPoint],
-) -> Result<(), ExperimentError>
-where
-    DB::ErrorType: 'static,
-{
-    let e = draw_error("the jamming plot");
-    root.fill(&WHITE).map_err(&e)?;
-    let lo = points.iter().map(|p| p.rate).fold(f64::INFINITY, f64::min) / 2.0;
-    let hi = points.iter().map(|p| p.rate).fold(0.0, f64::max) * 2.0;
-    let mut chart = ChartBuilder::on(root)
-        .caption(
-            "Binary disks (1:1.4): jammed area fraction against the growth rate",
-            ("sans-serif", 20),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d((lo..hi).log_scale(), 0.80..0.86)
-        .map_err(&e)?;
-    chart
-        .configure_mesh()
-        .x_desc("growth rate (diameter per unit time, kT = m = 1)")
-        .y_desc("jammed area fraction")
-        .draw()
-        .map_err(&e)?;
-    chart
-        .draw_series(LineSeries::new(
-            [(lo, OHERN), (hi, OHERN)],
-            RED.stroke_width(1),
-        ))
-        .map_err(&e)?
-        .label("O'Hern et al. (2003)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart
-        .draw_series(points.iter().map(|p| {
-            let (y, s) = (p.area_fraction.mean, p.area_fraction.error);
-            PathElement::new(vec![(p.rate, y - s), (p.rate, y + s)], BLUE.stroke_width(2))
-        }))
-        .map_err(&e)?;
-    chart
-        .draw_series(
-            points
-                .iter()
-                .map(|p| Circle::new((p.rate, p.area_fraction.mean), 4, BLUE.filled())),
-        )
-        .map_err(&e)?
-        .label("poolsim compress")
-        .legend(|(x, y)| Circle::new((x + 10, y), 4, BLUE.filled()));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE)
-        .border_style(BLACK)
-        .draw()
-        .map_err(&e)?;
-    root.present().map_err(&e)?;
-    Ok(())
 }

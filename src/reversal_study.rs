@@ -106,47 +106,38 @@ impl Figure for ErrorFigure<'_> {
     where
         DB::ErrorType: 'static,
     {
-        draw(root, self.0)
+        let points = self.0;
+        let e = draw_error("the reversal plot");
+        root.fill(&WHITE).map_err(&e)?;
+        let qmax = points.iter().map(|p| p.0).fold(1.0, f64::max) * 1.05;
+        let emax = points.iter().map(|p| p.1).fold(1e-12, f64::max) * 10.0;
+        let mut chart = ChartBuilder::on(root)
+            .caption(
+                "Reversal error against the quitting time Q (thesis 4.7 setup, seed 3)",
+                ("sans-serif", 20),
+            )
+            .margin(20)
+            .x_label_area_size(45)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.0..qmax, (1e-16..emax).log_scale())
+            .map_err(&e)?;
+        chart
+            .configure_mesh()
+            .x_desc("Q (the run goes from -Q to Q)")
+            .y_desc("largest position error")
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(&e)?;
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                BLUE.stroke_width(2),
+            ))
+            .map_err(&e)?;
+        chart
+            .draw_series(points.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
+            .map_err(&e)?;
+        root.present().map_err(&e)?;
+        Ok(())
     }
-}
-
-fn draw<DB: DrawingBackend>(
-    root: &DrawingArea<DB, plotters::coord::Shift>,
-    points: &[(f64, f64)],
-) -> Result<(), ExperimentError>
-where
-    DB::ErrorType: 'static,
-{
-    let e = draw_error("the reversal plot");
-    root.fill(&WHITE).map_err(&e)?;
-    let qmax = points.iter().map(|p| p.0).fold(1.0, f64::max) * 1.05;
-    let emax = points.iter().map(|p| p.1).fold(1e-12, f64::max) * 10.0;
-    let mut chart = ChartBuilder::on(root)
-        .caption(
-            "Reversal error against the quitting time Q (thesis 4.7 setup, seed 3)",
-            ("sans-serif", 20),
-        )
-        .margin(20)
-        .x_label_area_size(45)
-        .y_label_area_size(80)
-        .build_cartesian_2d(0.0..qmax, (1e-16..emax).log_scale())
-        .map_err(&e)?;
-    chart
-        .configure_mesh()
-        .x_desc("Q (the run goes from -Q to Q)")
-        .y_desc("largest position error")
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .draw()
-        .map_err(&e)?;
-    chart
-        .draw_series(LineSeries::new(
-            points.iter().copied(),
-            BLUE.stroke_width(2),
-        ))
-        .map_err(&e)?;
-    chart
-        .draw_series(points.iter().map(|&p| Circle::new(p, 4, BLUE.filled())))
-        .map_err(&e)?;
-    root.present().map_err(&e)?;
-    Ok(())
 }
