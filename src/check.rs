@@ -240,14 +240,13 @@ impl World for Snapshot<'_> {
     fn for_each_neighbor(&self, i: u32, f: &mut dyn FnMut(u32)) {
         let x = Self::x(self.table, &self.balls[i as usize], self.t);
         // in a periodic box the neighbours near one side include those near the other
-        let sides = match &self.table.period {
-            Some(b) => [-b.size.x, 0.0, b.size.x],
-            None => [0.0; 3],
-        };
-        let sides = if self.table.period.is_some() {
-            &sides[..]
-        } else {
-            &sides[..1]
+        let three;
+        let sides: &[f64] = match &self.table.period {
+            Some(b) => {
+                three = [-b.size.x, 0.0, b.size.x];
+                &three
+            }
+            None => &[0.0],
         };
         for &side in sides {
             let x = x + side;

@@ -17,9 +17,10 @@
 
 use crate::check::Checker;
 use crate::engine::event_list::{EventList, Options};
-use crate::engine::{BallState, Observer, RunError, Span, World};
+use crate::engine::{BallState, RunError, Span};
 use crate::growth::Growth;
 use crate::observe::Observables;
+use crate::run::Checked;
 use crate::scenario::{BallSpec, Scenario};
 use pdes_kernel::Interrupt;
 use std::f64::consts::PI;
@@ -199,7 +200,7 @@ pub fn compress(
 ) -> Result<Compressed, RunError> {
     cfg.check(start)
         .map_err(|e| RunError::Input(e.to_string()))?;
-    let mut state = thermalised(start, &start.balls, cfg.kt);
+    let mut state = thermalised(start, &BallState::initial(start, 0.0), cfg.kt);
     let n = state.balls.len() as f64;
     let mut t = 0.0;
     let mut cycles = Vec::new();
@@ -265,14 +266,14 @@ fn run_cycle(
         engine.stop_on(i.clone());
     }
     let mut observed = Observables::new(state, 0.0, 0.0, length);
-    let mut checker = cfg
-        .check
-        .then(|| Checker::new(&BallState::initial(state, 0.0), false));
-    let outcome = {
-        let mut both = Both(&mut observed, checker.as_mut());
-        engine.run(length, &mut both)?
+    let mut sinks = Checked {
+        checker: cfg
+            .check
+            .then(|| Checker::new(&BallState::initial(state, 0.0), false)),
+        user: &mut observed,
     };
-    if let Some(c) = checker.as_mut() {
+    let outcome = engine.run(length, &mut sinks)?;
+    if let Some(c) = sinks.checker.as_mut() {
         c.sweep(&engine, outcome.t)?;
     }
     let whole = outcome.t >= length;
@@ -287,19 +288,6 @@ fn run_cycle(
     Ok((outcome.balls, outcome.t, cycle))
 }
 
-/// The observables and, when checking, the checker.
-struct Both<'a>(&'a mut Observables, Option<&'a mut Checker>);
-
-impl Observer for Both<'_> {
-    fn on_event(&mut self, ev: &crate::engine::Event, world: &dyn World) -> Result<(), RunError> {
-        self.0.on_event(ev, world)?;
-        match self.1.as_mut() {
-            Some(c) => c.on_event(ev, world),
-            None => Ok(()),
-        }
-    }
-}
-
 /// The smallest diameter among `s`'s disks.
 fn smallest_diameter(s: &Scenario) -> f64 {
     2.0 * s
@@ -311,10 +299,10 @@ fn smallest_diameter(s: &Scenario) -> f64 {
 
 /// `template` with the disks `balls` (positions, velocities and radii at one time), every
 /// velocity scaled so that the mean kinetic energy per disk is `kt`.
-fn thermalised(template: &Scenario, balls: &[impl AsBall], kt: f64) -> Scenario {
+fn thermalised(template: &Scenario, balls: &[BallState], kt: f64) -> Scenario {
     let kinetic: f64 = balls
         .iter()
-        .map(|b| 0.5 * b.mass() * b.velocity().norm2())
+        .map(|b| 0.5 * b.mass * b.velocity().norm2())
         .sum();
     let scale = (kt * balls.len() as f64 / kinetic).sqrt();
     let mut s = template.clone();
@@ -324,46 +312,8 @@ fn thermalised(template: &Scenario, balls: &[impl AsBall], kt: f64) -> Scenario 
         .map(|(b, old)| BallSpec {
             colour: old.colour.clone(),
             label: old.label.clone(),
-            ..BallSpec::moving(b.position(), scale * b.velocity(), b.radius(), b.mass())
+            ..BallSpec::moving(b.traj.position, scale * b.velocity(), b.radius, b.mass)
         })
         .collect();
     s
-}
-
-/// A disk as a start or as an engine's state: what [`thermalised`] reads.
-trait AsBall {
-    fn position(&self) -> crate::geometry::Vec2;
-    fn velocity(&self) -> crate::geometry::Vec2;
-    fn radius(&self) -> f64;
-    fn mass(&self) -> f64;
-}
-
-impl AsBall for BallSpec {
-    fn position(&self) -> crate::geometry::Vec2 {
-        self.position
-    }
-    fn velocity(&self) -> crate::geometry::Vec2 {
-        self.velocity
-    }
-    fn radius(&self) -> f64 {
-        self.radius
-    }
-    fn mass(&self) -> f64 {
-        self.mass
-    }
-}
-
-impl AsBall for BallState {
-    fn position(&self) -> crate::geometry::Vec2 {
-        self.traj.position
-    }
-    fn velocity(&self) -> crate::geometry::Vec2 {
-        self.traj.velocity
-    }
-    fn radius(&self) -> f64 {
-        self.radius
-    }
-    fn mass(&self) -> f64 {
-        self.mass
-    }
 }

@@ -48,9 +48,7 @@ impl Growth {
         rb: f64,
         shift: Vec2,
     ) -> Contact {
-        let tref = a.t0.max(b.t0);
-        let dp = (b.at(tref) - a.at(tref)) + shift;
-        let dv = b.velocity - a.velocity;
+        let (tref, dp, dv) = crate::physics::relative(a, b, shift);
         let sum = ra + rb;
         approach(tref, dp, dv, sum * self.factor(tref), sum * self.rate)
     }

@@ -87,9 +87,21 @@ pub fn ball_ball_contact_across(
     rb: f64,
     shift: Vec2,
 ) -> Contact {
+    let (tref, dp, dv) = relative(a, b, shift);
+    approach(tref, dp, dv, ra + rb)
+}
+
+/// The later of two trajectories' fixes, and there the separation from `a` to the image of `b`
+/// that `shift` moves (once), and the velocity of `b` relative to `a`: what every prediction of
+/// a pair starts from.
+#[inline]
+pub fn relative(a: &Trajectory, b: &Trajectory, shift: Vec2) -> (f64, Vec2, Vec2) {
     let tref = a.t0.max(b.t0);
-    let dp = (b.at(tref) - a.at(tref)) + shift;
-    approach(tref, dp, b.velocity - a.velocity, ra + rb)
+    (
+        tref,
+        (b.at(tref) - a.at(tref)) + shift,
+        b.velocity - a.velocity,
+    )
 }
 
 /// When a ball of radius `r` touches the fixed point `c`, a pocket's corner (thesis 3.1.4).

@@ -189,12 +189,14 @@ fn energies(balls: &[BallState]) -> (f64, f64) {
 pub const MAX_TIME_STEPS: f64 = 1e9;
 
 /// Forwards events to an optional checker, then to the caller's observer.
-struct Sinks<'a> {
-    checker: Option<Checker>,
-    user: &'a mut dyn Observer,
+pub(crate) struct Checked<'a> {
+    /// The invariant checker, when checking.
+    pub(crate) checker: Option<Checker>,
+    /// The caller's observer.
+    pub(crate) user: &'a mut dyn Observer,
 }
 
-impl Observer for Sinks<'_> {
+impl Observer for Checked<'_> {
     fn on_event(&mut self, ev: &Event, world: &dyn World) -> Result<(), RunError> {
         if let Some(c) = &mut self.checker {
             c.on_event(ev, world)?;
@@ -361,7 +363,7 @@ pub fn execute(
     let checker = cfg
         .check
         .then(|| Checker::new(&initial, table.is_elastic() && cfg.thermostat.is_none()));
-    let mut sinks = Sinks { checker, user: obs };
+    let mut sinks = Checked { checker, user: obs };
     let (e0, _) = energies(&initial);
     // the engine holds the balls from here on: a copy less at the peak of memory
     drop(initial);

@@ -16,7 +16,7 @@
 //! Neighbours are found in a cell list built afresh at each sample, so a sample costs O(N).
 
 use crate::engine::{Event, Frame, Observer, RunError, Table, World};
-use crate::geometry::Vec2;
+use crate::geometry::{PeriodicBox, Vec2};
 
 /// Which structural observables to take.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -249,13 +249,13 @@ impl Observer for Structure {
     }
 }
 
-/// Points in square cells over a table's box, with the separations to the nearest image in a
-/// periodic box.
+/// Points in square cells over a table's box; separations go to the nearest image in a periodic
+/// box.
 struct Cells {
     points: Vec<Vec2>,
     lo: Vec2,
     size: Vec2,
-    periodic: bool,
+    period: Option<PeriodicBox>,
     side: f64,
     nx: usize,
     ny: usize,
@@ -277,7 +277,7 @@ impl Cells {
             points,
             lo: table.lo,
             size,
-            periodic: table.period.is_some(),
+            period: table.period,
             side: (size.x / nx as f64).min(size.y / ny as f64),
             nx,
             ny,
@@ -310,12 +310,12 @@ impl Cells {
         // would wrap onto itself in a periodic box, every cell once
         let span = |c: usize, n: usize| -> Vec<usize> {
             let n = n as i64;
-            if self.periodic && 2 * k + 1 >= n {
+            if self.period.is_some() && 2 * k + 1 >= n {
                 (0..n as usize).collect()
             } else {
                 (c as i64 - k..=c as i64 + k)
                     .filter_map(|x| {
-                        if self.periodic {
+                        if self.period.is_some() {
                             Some(x.rem_euclid(n) as usize)
                         } else {
                             (0..n).contains(&x).then_some(x as usize)
@@ -329,20 +329,12 @@ impl Cells {
             for &x in &xs {
                 for &j in &self.members[y * self.nx + x] {
                     if j as usize != i {
-                        f(j, self.separation(p, self.points[j as usize]));
+                        let d = self.points[j as usize] - p;
+                        f(j, self.period.map_or(d, |b| b.nearest(d)));
                     }
                 }
             }
         }
-    }
-
-    fn separation(&self, from: Vec2, to: Vec2) -> Vec2 {
-        let d = to - from;
-        if !self.periodic {
-            return d;
-        }
-        let wrap = |v: f64, l: f64| v - l * (v / l).round();
-        Vec2::new(wrap(d.x, self.size.x), wrap(d.y, self.size.y))
     }
 
     /// |⟨ψ6⟩| over the points, each over its six nearest neighbours (the search widens until
@@ -383,7 +375,7 @@ impl Cells {
 mod tests {
     use super::*;
     use crate::engine::BallState;
-    use crate::geometry::{PeriodicBox, Trajectory};
+    use crate::geometry::Trajectory;
 
     fn table(side: f64, periodic: bool) -> Table {
         Table {

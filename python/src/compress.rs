@@ -32,7 +32,6 @@ pub fn compress<'py>(
         check: ask.check,
         ..CompressConfig::default()
     };
-    cfg.check(&start).map_err(value_error)?;
     let done = py
         .detach(|| grow(&start, &cfg, None, &mut |_| {}))
         .map_err(value_error)?;
