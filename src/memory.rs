@@ -67,7 +67,7 @@ pub struct Estimate {
 pub fn estimate(balls: usize, engine: &crate::run::EngineKind) -> Estimate {
     use crate::run::EngineKind;
     let (footprint, quadratic) = match engine {
-        EngineKind::EventList => (Footprint::EventList, false),
+        EngineKind::EventList | EngineKind::Regions { .. } => (Footprint::EventList, false),
         EngineKind::TimeStep { .. } => (Footprint::TimeStep, false),
         EngineKind::Objects { .. } => (Footprint::Sectored, true),
         EngineKind::Sectored { .. } => (Footprint::Sectored, false),

@@ -7,6 +7,7 @@ use crate::check::Checker;
 use crate::checkpoint::Checkpoint;
 use crate::engine::event_list::{self, EventList};
 use crate::engine::objects::Objects;
+use crate::engine::regions::RegionsEngine;
 use crate::engine::time_step::{self, TimeStep};
 use crate::engine::{
     BallState, Engine, Event, EventCounts, Frame, Observer, Outcome, RunError, Span, Table, World,
@@ -59,6 +60,14 @@ pub enum EngineKind {
         sectors: Option<SectorChoice>,
         /// Which balls tell the fixed objects of their trajectories (sectored).
         news: FixedNews,
+    },
+    /// The event list cut into strips of the table, each a kernel object: sequential, or in
+    /// parallel under Time Warp.
+    Regions {
+        /// How many strips.
+        count: u32,
+        /// Time Warp's workers, chaos and throttles; `None`: the sequential executor.
+        tw: Option<TwConfig>,
     },
 }
 
@@ -126,6 +135,7 @@ impl EngineKind {
             EngineKind::TimeStep { .. } => "time-step",
             EngineKind::Objects { .. } | EngineKind::Sectored { .. } => "objects",
             EngineKind::TimeWarp { .. } => "time-warp",
+            EngineKind::Regions { .. } => "regions",
         }
     }
 }
@@ -299,6 +309,23 @@ pub fn build_engine(scenario: &Scenario, cfg: &RunConfig) -> Result<Box<dyn Engi
                 time_step::Options { dt, span: cfg.span },
             ))
         }
+        EngineKind::Regions { count, tw } => {
+            if cfg.span.frame_time.is_some() || cfg.span.reverse_at.is_some() {
+                return Err(RunError::Input(
+                    "--engine regions: draws no frames and runs no reversal yet; use the event \
+                     list"
+                        .into(),
+                ));
+            }
+            if cfg.checkpoint_every.is_some() {
+                return Err(RunError::Input(
+                    "--engine regions: takes no checkpoints yet; use the event list".into(),
+                ));
+            }
+            let engine = RegionsEngine::new(scenario, count, cfg.span.start, tw)
+                .map_err(|e| RunError::Input(e.to_string()))?;
+            Box::new(engine)
+        }
         kind => Box::new(
             build_objects(scenario, kind, cfg.span)?.expect("every other kind runs objects"),
         ),
@@ -333,7 +360,9 @@ pub fn build_objects(
         Ok(layout)
     };
     Ok(Some(match kind {
-        EngineKind::EventList | EngineKind::TimeStep { .. } => return Ok(None),
+        EngineKind::EventList | EngineKind::TimeStep { .. } | EngineKind::Regions { .. } => {
+            return Ok(None)
+        }
         EngineKind::Objects { delay } => Objects::new(scenario, delay, span),
         EngineKind::Sectored { sectors, news } => {
             Objects::sectored(scenario, layout(sectors, news)?, span)

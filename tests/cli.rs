@@ -988,7 +988,7 @@ fn flags_are_named_as_given() {
     assert!(e.ends_with("got 0"), "{e}");
     let e = bad_usage(&["reverse", "reversal", "--quit", "3", "--workers", "2"]);
     assert!(
-        e.contains("--workers: only the time-warp engine takes it"),
+        e.contains("--workers: only the time-warp and regions engines take it"),
         "{e}"
     );
     let r = success_json(&[

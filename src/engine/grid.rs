@@ -222,6 +222,55 @@ impl Grid {
         Grid::laid_out(table, layouts, level)
     }
 
+    /// An empty grid of exactly `nx` × `ny` cells over `table`'s box for balls of radius at
+    /// most `rmax`, in the dense form, with room for `n` ball indices (more come with
+    /// [`Grid::hold_balls`]): one layout that never changes, for an engine that lays several
+    /// grids side by side and needs their columns to stay where it put them.
+    pub fn with_dims(table: &Table, n: usize, rmax: f64, (nx, ny): (u32, u32)) -> Grid {
+        let layouts = Layouts {
+            dims: vec![(nx, ny)],
+            most: f64::from(nx) * f64::from(ny),
+            w_min: 2.0 * rmax * CELL_MARGIN,
+            rmax,
+            n,
+            periodic: false,
+        };
+        Grid::laid_out(table, layouts, 0)
+    }
+
+    /// The cells along x and y of the coarsest layout this grid may take with at least
+    /// `columns` cells along x, if it has one.
+    pub fn dims_with_columns(&self, columns: u32) -> Option<(u32, u32)> {
+        self.layouts
+            .dims
+            .iter()
+            .rev()
+            .find(|d| d.0 >= columns)
+            .copied()
+    }
+
+    /// Makes room for ball indices below `n`.
+    pub fn hold_balls(&mut self, n: usize) {
+        if self.cell_of.len() < n {
+            self.cell_of.resize(n, NIL);
+        }
+    }
+
+    /// Puts ball `i` into the cell of column `cx` whose row holds point `p`, and returns that
+    /// cell (dense layout).
+    pub fn insert_in_column(&mut self, i: u32, cx: u32, p: Vec2) -> u32 {
+        let (_, cy) = self.coords_at(p);
+        let c = cy * self.nx + cx.min(self.nx - 1);
+        self.insert(i, c);
+        c
+    }
+
+    /// The column of cell `c`.
+    #[inline]
+    pub fn column(&self, c: u32) -> u32 {
+        self.coords(c).0
+    }
+
     /// An empty grid in `layouts`' layout number `level`.
     fn laid_out(table: &Table, layouts: Layouts, level: usize) -> Grid {
         let (nx, ny) = layouts.dims[level];

@@ -10,6 +10,7 @@ pub mod event_list;
 pub mod grid;
 pub mod objects;
 pub mod partition;
+pub mod regions;
 pub mod time_step;
 
 use crate::checkpoint::Checkpoint;

@@ -4,6 +4,7 @@
 
 pub mod layout;
 pub mod pool;
+pub mod regions;
 pub mod sectored;
 
 /// The message types of the thesis (and of its sectored objects), in the order the summary

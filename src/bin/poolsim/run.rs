@@ -46,9 +46,12 @@ pub struct RunArgs {
     /// Check invariants at every event; a violation stops the run with exit status 1.
     #[arg(long)]
     pub check: bool,
-    /// Worker threads (time-warp engine; default: this machine's cores).
+    /// Worker threads (time-warp and regions engines; default: this machine's cores).
     #[arg(long)]
     pub workers: Option<usize>,
+    /// Strips the regions engine cuts the table into (default: one per worker).
+    #[arg(long)]
+    pub regions: Option<u32>,
     /// Time Warp's optimism window: no batch later than GVT plus this (simulation time).
     #[arg(long = "tw-window", allow_negative_numbers = true)]
     pub tw_window: Option<f64>,
@@ -149,6 +152,7 @@ impl RunArgs {
             json: false,
             check: false,
             workers: None,
+            regions: None,
             tw_window: None,
             tw_memory: None,
             gvt_interval: None,
@@ -206,6 +210,16 @@ pub fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure
                     Ok(EngineKind::Sectored { sectors, news })
                 }
             }
+        }
+        Engine::Regions => {
+            let tw = tw_config(a)?;
+            let count = a.regions.unwrap_or(tw.workers as u32);
+            if count == 0 {
+                return Err(usage("--regions: must be at least 1"));
+            }
+            // one worker runs the regions in turn on the sequential executor
+            let tw = (tw.workers > 1).then_some(tw);
+            Ok(EngineKind::Regions { count, tw })
         }
         Engine::TimeWarp => {
             let delay = nv_delay(a.newvelocity_delay, scenario);
@@ -309,8 +323,15 @@ pub fn check_outputs_apart(a: &RunArgs, resuming: bool) -> Result<(), Failure> {
 
 /// Refuses options the chosen engine does not take.
 pub fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure> {
-    let objects = !matches!(engine, EngineKind::EventList | EngineKind::TimeStep { .. });
-    let time_warp = matches!(engine, EngineKind::TimeWarp { .. });
+    let objects = !matches!(
+        engine,
+        EngineKind::EventList | EngineKind::TimeStep { .. } | EngineKind::Regions { .. }
+    );
+    let regions = matches!(engine, EngineKind::Regions { .. });
+    let time_warp = regions || matches!(engine, EngineKind::TimeWarp { .. });
+    if a.regions.is_some() && !regions {
+        return Err(usage("--regions: only the regions engine takes it"));
+    }
     let sectored = matches!(
         engine,
         EngineKind::Sectored { .. }
@@ -346,7 +367,9 @@ pub fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure
         ("--tw-burst", a.tw_burst.is_some()),
     ] {
         if given && !time_warp {
-            return Err(usage(format!("{flag}: only the time-warp engine takes it")));
+            return Err(usage(format!(
+                "{flag}: only the time-warp and regions engines take it"
+            )));
         }
     }
     if a.sample_every.is_some() && a.samples.is_none() && a.observe.is_none() {
@@ -359,7 +382,12 @@ pub fn check_options_fit(a: &RunArgs, engine: &EngineKind) -> Result<(), Failure
         ("--observe", a.observe.is_some()),
     ];
     if let Some((flag, _)) = sampling.iter().find(|(_, given)| *given) {
-        if sectored || matches!(engine, EngineKind::TimeStep { .. }) {
+        if sectored
+            || matches!(
+                engine,
+                EngineKind::TimeStep { .. } | EngineKind::Regions { .. }
+            )
+        {
             return Err(usage(format!(
                 "{flag}: the event-list engine, and the objects and time-warp engines without \
                  sectors, take samples"

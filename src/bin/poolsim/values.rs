@@ -17,6 +17,9 @@ pub enum Engine {
     Objects,
     /// The pool objects under Time Warp.
     TimeWarp,
+    /// The event list cut into strips of the table, each a kernel object: one worker runs
+    /// them in turn, more run them in parallel under Time Warp.
+    Regions,
 }
 
 /// `--fixed-news`: which balls tell cushions, pockets and corners of a new trajectory.
