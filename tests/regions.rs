@@ -1,0 +1,147 @@
+//! The regions engine against the event list: for any number of regions, on one worker (the
+//! sequential executor) and under Time Warp on 2 and 3 workers with and without chaos, the same
+//! physical events in the same order and the same final state, bit for bit, under `--check`.
+
+mod common;
+
+use common::{random_scenario, traced};
+use pdes_kernel::time_warp::TwConfig;
+use poolsim::run::EngineKind;
+use poolsim::scenario::{builtin, load, Scenario};
+use proptest::prelude::*;
+
+/// `count` regions on `workers` workers (one: the sequential executor), with chaos `chaos`.
+fn regions(count: u32, workers: usize, chaos: Option<u64>) -> EngineKind {
+    let tw = (workers > 1).then_some(TwConfig {
+        workers,
+        chaos,
+        gvt_interval: Some(64),
+        ..TwConfig::default()
+    });
+    EngineKind::Regions { count, tw }
+}
+
+/// Whether `s`'s table has grid columns enough for `count` regions.
+fn fits(s: &Scenario, count: u32) -> bool {
+    poolsim::model::regions::Regions::new(s, count, 0.0).is_ok()
+}
+
+/// Runs `s` on the event list and on `engines`, and asserts every trace and digest equal;
+/// returns how many of `engines` the table had columns for.
+fn assert_same(s: &Scenario, engines: &[EngineKind]) -> usize {
+    let (want, want_sum) = traced(s, EngineKind::EventList, true);
+    let mut ran = 0;
+    for &engine in engines {
+        let EngineKind::Regions { count, .. } = engine else {
+            unreachable!("regions only")
+        };
+        if !fits(s, count) {
+            continue;
+        }
+        let (got, sum) = traced(s, engine, true);
+        assert_eq!(got, want, "{}: {engine:?}: traces differ", s.name);
+        assert_eq!(
+            sum.final_state_digest, want_sum.final_state_digest,
+            "{}: {engine:?}: digests differ",
+            s.name
+        );
+        ran += 1;
+    }
+    ran
+}
+
+/// The sequential and parallel settings every built-in and hard case runs on.
+fn settings() -> Vec<EngineKind> {
+    vec![
+        regions(1, 1, None),
+        regions(2, 1, None),
+        regions(3, 1, None),
+        regions(5, 1, None),
+        regions(2, 2, None),
+        regions(3, 2, Some(7)),
+        regions(4, 3, Some(11)),
+    ]
+}
+
+#[test]
+fn every_builtin_is_exact() {
+    for (name, balls) in [
+        ("gas", 400),
+        ("pool", 0),
+        ("cradle", 0),
+        ("plate1", 0),
+        ("implosion", 300),
+        ("disks", 400),
+    ] {
+        let mut p = builtin::Params::default();
+        if balls > 0 {
+            p.balls = Some(balls);
+        }
+        let mut s = builtin::build(name, &p).unwrap();
+        s.until = s.until.min(3.0);
+        let ran = assert_same(&s, &settings());
+        assert!(ran >= 5, "{name}: only {ran} settings had columns enough");
+    }
+}
+
+#[test]
+fn every_hard_case_is_exact() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let s = load(path.to_str().unwrap(), &builtin::Params::default()).unwrap();
+            let ran = assert_same(&s, &settings());
+            assert!(ran >= 2, "{}: only {ran} settings fit", s.name);
+            n += 1;
+        }
+    }
+    assert!(n >= 10, "only {n} hard cases found");
+}
+
+#[test]
+fn a_dense_gas_crosses_borders_often_and_stays_exact() {
+    let p = builtin::Params {
+        balls: Some(900),
+        area_fraction: Some(0.6),
+        ..Default::default()
+    };
+    let mut s = builtin::build("disks", &p).unwrap();
+    s.until = 2.0;
+    let ran = assert_same(
+        &s,
+        &[
+            regions(6, 1, None),
+            regions(6, 2, Some(3)),
+            regions(8, 3, Some(4)),
+        ],
+    );
+    assert_eq!(ran, 3);
+}
+
+#[test]
+fn too_few_columns_is_refused_with_the_count() {
+    let s = builtin::build("cradle", &builtin::Params::default()).unwrap();
+    let err = poolsim::model::regions::Regions::new(&s, 500, 0.0)
+        .err()
+        .expect("500 regions do not fit a 1000-wide table of radius-30 balls");
+    let msg = err.to_string();
+    assert!(
+        msg.contains("500 regions need at least 1000 grid columns"),
+        "{msg}"
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn random_tables_are_exact(s in random_scenario(), chaos in 1u64..1000) {
+        let ran = assert_same(
+            &s,
+            &[regions(2, 1, None), regions(3, 1, None), regions(3, 2, Some(chaos))],
+        );
+        prop_assert!(ran >= 1);
+    }
+}
