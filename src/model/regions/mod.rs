@@ -34,14 +34,14 @@
 
 mod region;
 
-pub use region::Region;
+pub use region::{Known, Region, Undo};
 
 use crate::engine::grid::Grid;
 use crate::engine::{BallState, Event, Table};
 use crate::geometry::{Trajectory, Vec2};
 use crate::scenario::Scenario;
 use crate::vtime::Key;
-use pdes_kernel::{Ctx, Envelope, Model, VTime};
+use pdes_kernel::{Ctx, Envelope, Model, Saving, VTime};
 use std::sync::Arc;
 
 /// A ball's course as a neighbour hears of it.
@@ -306,16 +306,17 @@ impl Regions {
     /// if that is another.
     fn schedule(&self, ctx: &mut Ctx<'_, Self>, state: &mut Region) {
         let next = state.first_key().cloned();
-        if state.wake.as_ref().map(|w| &w.0) == next.as_ref() {
+        if state.wake().map(|w| &w.0) == next.as_ref() {
             return;
         }
-        if let Some((_, h)) = state.wake.take() {
-            ctx.cancel(h);
+        if let Some((_, h)) = state.wake() {
+            ctx.cancel(*h);
         }
-        if let Some(key) = next {
+        let wake = next.map(|key| {
             let h = ctx.send_at(ctx.me(), VTime::at(key.clone()), RegionMsg::Wake);
-            state.wake = Some((key, h));
-        }
+            (key, h)
+        });
+        state.set_wake(wake);
     }
 }
 
@@ -324,7 +325,7 @@ impl Model for Regions {
     type Msg = RegionMsg;
     type State = Region;
     type Output = Event;
-    type Undo = ();
+    type Undo = Undo;
 
     fn kind_names(&self) -> &'static [&'static str] {
         &KINDS
@@ -356,6 +357,7 @@ impl Model for Regions {
         batch: &[Envelope<RegionMsg>],
     ) {
         let now = ctx.now().clone();
+        state.begin(ctx.saves());
         let mut woken = false;
         for env in batch {
             match &env.msg {
@@ -364,7 +366,7 @@ impl Model for Regions {
             }
         }
         if woken {
-            state.wake = None;
+            state.set_wake(None);
             let mut done = Vec::new();
             state.run_due(&now.key, &mut done);
             for d in done {
@@ -377,6 +379,15 @@ impl Model for Regions {
             }
         }
         self.schedule(ctx, state);
+        for undo in state.end() {
+            ctx.save(|| undo);
+        }
+    }
+
+    fn saving(&self, _obj: u32) -> Saving<Region, Undo> {
+        Saving::Incremental {
+            restore: Region::restore,
+        }
     }
 }
 

@@ -40,7 +40,7 @@ enum Partner {
 
 /// A ball as a region knows it: one of its own, or a ghost.
 #[derive(Clone, Debug)]
-pub(super) struct Known {
+pub struct Known {
     /// Its global index.
     pub(super) gid: u32,
     /// Its trajectory since it last turned (for a pocketed ball: where it dropped in).
@@ -68,6 +68,24 @@ pub(super) struct Known {
     queued: Key,
 }
 
+/// The old value of one part of a region, recorded before a batch changes it, so that Time
+/// Warp can put it back ([`Region::restore`]).
+#[derive(Clone, Debug)]
+pub enum Undo {
+    /// Record `0` was this (with its cell and queued key).
+    Ball(u32, Box<Known>),
+    /// A record was added at the end.
+    Grew,
+    /// Ball `0`'s local index was this.
+    Local(u32, Option<u32>),
+    /// A freed index was added to the free list.
+    Freed,
+    /// This freed index was taken from the free list.
+    Reused(u32),
+    /// The pending wake-up was this.
+    Wake(Option<(Key, pdes_kernel::Handle)>),
+}
+
 /// A region: its balls and ghosts, its grid and its queue.
 #[derive(Clone)]
 pub struct Region {
@@ -85,7 +103,13 @@ pub struct Region {
     /// The time of the batch being run.
     now: f64,
     /// The wake-up message the region sent itself, if it is still to come: its key and handle.
-    pub(super) wake: Option<(Key, pdes_kernel::Handle)>,
+    wake: Option<(Key, pdes_kernel::Handle)>,
+    /// Whether the batch being run keeps the old values of what it changes.
+    journaling: bool,
+    /// Old values kept in the batch being run, oldest first.
+    journal: Vec<Undo>,
+    /// Records whose old values the batch being run has kept.
+    kept: Vec<u32>,
 }
 
 /// What one event of a region produced: the physical event to report (if this region reports
@@ -109,6 +133,87 @@ impl Region {
             queue: BTreeSet::new(),
             now: start,
             wake: None,
+            journaling: false,
+            journal: Vec::new(),
+            kept: Vec::new(),
+        }
+    }
+
+    /// Starts a batch: whether it keeps the old values of what it changes.
+    pub(super) fn begin(&mut self, journaling: bool) {
+        self.journaling = journaling;
+        self.kept.clear();
+    }
+
+    /// Ends a batch: the old values it kept, oldest first.
+    pub(super) fn end(&mut self) -> std::vec::Drain<'_, Undo> {
+        self.journaling = false;
+        self.journal.drain(..)
+    }
+
+    /// Keeps `undo` if the batch keeps old values.
+    #[inline]
+    fn log(&mut self, undo: impl FnOnce(&Region) -> Undo) {
+        if self.journaling {
+            let u = undo(self);
+            self.journal.push(u);
+        }
+    }
+
+    /// Keeps record `i` as it is, once per batch, before the batch changes it.
+    #[inline]
+    fn keep(&mut self, i: u32) {
+        if self.journaling && !self.kept.contains(&i) {
+            self.kept.push(i);
+            let old = Box::new(self.balls[i as usize].clone());
+            self.journal.push(Undo::Ball(i, old));
+        }
+    }
+
+    /// The pending wake-up.
+    pub(super) fn wake(&self) -> Option<&(Key, pdes_kernel::Handle)> {
+        self.wake.as_ref()
+    }
+
+    /// Sets the pending wake-up.
+    pub(super) fn set_wake(&mut self, wake: Option<(Key, pdes_kernel::Handle)>) {
+        self.log(|r| Undo::Wake(r.wake.clone()));
+        self.wake = wake;
+    }
+
+    /// Puts back one old value (Time Warp's rollback, latest first).
+    pub fn restore(&mut self, undo: Undo) {
+        match undo {
+            Undo::Ball(i, old) => {
+                let cur = &self.balls[i as usize];
+                if cur.cell != NOWHERE {
+                    self.grid.remove_from(i, cur.cell);
+                }
+                if cur.queued.t.is_finite() {
+                    self.queue.remove(&(cur.queued.clone(), i));
+                }
+                if old.cell != NOWHERE {
+                    self.grid.insert(i, old.cell);
+                }
+                if old.queued.t.is_finite() {
+                    self.queue.insert((old.queued.clone(), i));
+                }
+                self.balls[i as usize] = *old;
+            }
+            Undo::Grew => {
+                self.balls.pop();
+            }
+            Undo::Local(gid, old) => {
+                match old {
+                    Some(i) => self.local.insert(gid, i),
+                    None => self.local.remove(&gid),
+                };
+            }
+            Undo::Freed => {
+                self.free.pop();
+            }
+            Undo::Reused(i) => self.free.push(i),
+            Undo::Wake(w) => self.wake = w,
         }
     }
 
@@ -143,6 +248,7 @@ impl Region {
             }
             None => self.fresh(g.gid),
         };
+        self.keep(i);
         let counter = self.balls[i as usize].counter.wrapping_add(1);
         let key = Key::at(f64::INFINITY, 0);
         self.balls[i as usize] = Known {
@@ -172,8 +278,12 @@ impl Region {
     /// A local index for ball `gid`, new or reused.
     fn fresh(&mut self, gid: u32) -> u32 {
         let i = match self.free.pop() {
-            Some(i) => i,
+            Some(i) => {
+                self.log(|_| Undo::Reused(i));
+                i
+            }
             None => {
+                self.log(|_| Undo::Grew);
                 let i = self.balls.len() as u32;
                 self.balls.push(Known {
                     gid,
@@ -197,12 +307,14 @@ impl Region {
                 i
             }
         };
+        self.log(|r| Undo::Local(gid, r.local.get(&gid).copied()));
         self.local.insert(gid, i);
         i
     }
 
     /// Takes record `i` off its cell and out of the queue.
     fn unplace(&mut self, i: u32) {
+        self.keep(i);
         let b = &mut self.balls[i as usize];
         if b.cell != NOWHERE {
             self.grid.remove_from(i, b.cell);
@@ -216,10 +328,13 @@ impl Region {
 
     /// Forgets ghost `gid` (it went out of reach).
     fn forget(&mut self, gid: u32) {
-        if let Some(i) = self.local.remove(&gid) {
+        if let Some(&i) = self.local.get(&gid) {
+            self.log(|_| Undo::Local(gid, Some(i)));
+            self.local.remove(&gid);
             self.unplace(i);
             let b = &mut self.balls[i as usize];
             b.counter = b.counter.wrapping_add(1);
+            self.log(|_| Undo::Freed);
             self.free.push(i);
         }
     }
@@ -278,6 +393,7 @@ impl Region {
     /// Recomputes record `i`'s earliest event and cell exit, and queues it. A ball of this
     /// region meets everything near it; a ghost only this region's balls.
     pub(super) fn predict(&mut self, i: u32) {
+        self.keep(i);
         let mut best = (Key::at(f64::INFINITY, 0), Partner::Nothing);
         let cell = self.balls[i as usize].cell;
         if cell != NOWHERE {
@@ -354,6 +470,7 @@ impl Region {
 
     /// Sets record `i` on a new course from `key` on.
     fn turn(&mut self, i: u32, key: &Key, velocity: crate::geometry::Vec2) {
+        self.keep(i);
         let b = &mut self.balls[i as usize];
         b.traj = Trajectory {
             position: b.traj.at(key.t),
@@ -470,6 +587,7 @@ impl Region {
     /// Record `i`'s centre leaves its cell: it moves on in the grid, and a ball of this region
     /// that comes near a border, leaves it, or crosses it changes who must hear of it.
     fn cross(&mut self, i: u32) -> Done {
+        self.keep(i);
         let b = &self.balls[i as usize];
         let (from, to) = (b.cell, b.cross.1);
         self.grid.remove_from(i, from);
