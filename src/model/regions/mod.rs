@@ -284,6 +284,7 @@ impl Regions {
             for i in 0..r.balls.len() as u32 {
                 r.predict(i);
             }
+            r.settle(start);
         }
         let model = Regions {
             table,

@@ -11,6 +11,7 @@
 //! sends its new course.
 
 use super::{Ghost, News, Shape};
+use crate::engine::calendar::{Calendar, Entries, Place};
 use crate::engine::grid::Grid;
 use crate::engine::{BallState, Event, EventKind, Fixed};
 use crate::geometry::Trajectory;
@@ -18,7 +19,6 @@ use crate::physics::{self, Contact};
 use crate::vtime::{pair, Key};
 use rustc_hash::FxHashMap;
 use std::cmp::Ordering;
-use std::collections::BTreeSet;
 use std::sync::Arc;
 
 /// The pair code of a ball leaving its cell: after every physical event of its instant.
@@ -66,6 +66,32 @@ pub struct Known {
     phys: (Key, Partner),
     /// The key it is queued at.
     queued: Key,
+    /// Where its entry is in the calendar.
+    place: Place,
+}
+
+/// What the calendar sees of a region's records.
+struct Queued<'a> {
+    balls: &'a mut [Known],
+}
+
+impl Entries for Queued<'_> {
+    #[inline]
+    fn key(&self, i: u32) -> &Key {
+        &self.balls[i as usize].queued
+    }
+    #[inline]
+    fn place(&self, i: u32) -> Place {
+        self.balls[i as usize].place
+    }
+    #[inline]
+    fn set_place(&mut self, i: u32, place: Place) {
+        self.balls[i as usize].place = place;
+    }
+    #[inline]
+    fn opened(&self, i: u32) {
+        pdes_kernel::prefetch::prefetch_all(&self.balls[i as usize]);
+    }
 }
 
 /// The old value of one part of a region, recorded before a batch changes it, so that Time
@@ -74,8 +100,8 @@ pub struct Known {
 pub enum Undo {
     /// Record `0` was this (with its cell and queued key).
     Ball(u32, Box<Known>),
-    /// A record was added at the end.
-    Grew,
+    /// Record `0` was added at the end.
+    Grew(u32),
     /// Ball `0`'s local index was this.
     Local(u32, Option<u32>),
     /// A freed index was added to the free list.
@@ -98,8 +124,8 @@ pub struct Region {
     /// Freed local indices.
     free: Vec<u32>,
     grid: Grid,
-    /// Every ball's queued key.
-    queue: BTreeSet<(Key, u32)>,
+    /// Every ball's queued event.
+    queue: Calendar,
     /// The time of the batch being run.
     now: f64,
     /// The wake-up message the region sent itself, if it is still to come: its key and handle.
@@ -130,7 +156,7 @@ impl Region {
             local: FxHashMap::default(),
             free: Vec::new(),
             grid,
-            queue: BTreeSet::new(),
+            queue: Calendar::heap_only(start),
             now: start,
             wake: None,
             journaling: false,
@@ -185,24 +211,22 @@ impl Region {
     pub fn restore(&mut self, undo: Undo) {
         match undo {
             Undo::Ball(i, old) => {
+                self.unqueue(i);
                 let cur = &self.balls[i as usize];
                 if cur.cell != NOWHERE {
                     self.grid.remove_from(i, cur.cell);
                 }
-                if cur.queued.t.is_finite() {
-                    self.queue.remove(&(cur.queued.clone(), i));
-                }
                 if old.cell != NOWHERE {
                     self.grid.insert(i, old.cell);
                 }
-                if old.queued.t.is_finite() {
-                    self.queue.insert((old.queued.clone(), i));
-                }
-                self.balls[i as usize] = *old;
+                self.balls[i as usize] = Known {
+                    place: Place::NOWHERE,
+                    ..*old
+                };
+                self.enqueue(i);
             }
-            Undo::Grew => {
-                self.balls.pop();
-            }
+            // the record stays (the calendar may still name it), free for reuse
+            Undo::Grew(i) => self.free.push(i),
             Undo::Local(gid, old) => {
                 match old {
                     Some(i) => self.local.insert(gid, i),
@@ -233,9 +257,54 @@ impl Region {
         })
     }
 
+    /// The record with the earliest queued event, if any.
+    fn first(&mut self) -> Option<u32> {
+        let (queue, mut entries) = self.calendar();
+        queue.first(&mut entries)
+    }
+
     /// The key of its earliest queued event, if any.
-    pub(super) fn first_key(&self) -> Option<&Key> {
-        self.queue.first().map(|(k, _)| k)
+    pub(super) fn first_key(&mut self) -> Option<&Key> {
+        let i = self.first()?;
+        Some(&self.balls[i as usize].queued)
+    }
+
+    /// The calendar, and what it sees of the records.
+    fn calendar(&mut self) -> (&mut Calendar, Queued<'_>) {
+        let entries = Queued {
+            balls: &mut self.balls,
+        };
+        (&mut self.queue, entries)
+    }
+
+    /// Takes record `i` out of the calendar.
+    fn unqueue(&mut self, i: u32) {
+        self.balls[i as usize].queued = Key::at(f64::INFINITY, 0);
+        let (queue, mut entries) = self.calendar();
+        queue.set(&mut entries, i);
+    }
+
+    /// Puts record `i` into the calendar at its queued key.
+    fn enqueue(&mut self, i: u32) {
+        let (queue, mut entries) = self.calendar();
+        queue.set(&mut entries, i);
+    }
+
+    /// Lays the calendar out for the region's balls, once their first events are predicted:
+    /// its buckets as wide as three of the mean gaps between them.
+    pub(super) fn settle(&mut self, start: f64) {
+        let times: Vec<f64> = (self.balls.iter())
+            .map(|b| b.queued.t)
+            .filter(|t| t.is_finite())
+            .collect();
+        let n = times.len().max(1) as f64;
+        let gap = times.iter().map(|t| t - start).sum::<f64>() / n / n;
+        self.queue = Calendar::heap_only(start);
+        self.queue = Calendar::new(self.balls.len(), start, gap);
+        for i in 0..self.balls.len() as u32 {
+            self.balls[i as usize].place = Place::NOWHERE;
+            self.enqueue(i);
+        }
     }
 
     /// Takes ball or ghost `g` in, in the cell of its centre at `now` (or in column `column`
@@ -264,6 +333,7 @@ impl Region {
             cross: (f64::INFINITY, 0),
             phys: (key.clone(), Partner::Nothing),
             queued: key,
+            place: Place::NOWHERE,
         };
         if g.pocket.is_none() {
             let p = g.traj.at(self.now);
@@ -283,8 +353,8 @@ impl Region {
                 i
             }
             None => {
-                self.log(|_| Undo::Grew);
                 let i = self.balls.len() as u32;
+                self.log(|_| Undo::Grew(i));
                 self.balls.push(Known {
                     gid,
                     traj: Trajectory {
@@ -302,6 +372,7 @@ impl Region {
                     cross: (f64::INFINITY, 0),
                     phys: (Key::at(f64::INFINITY, 0), Partner::Nothing),
                     queued: Key::at(f64::INFINITY, 0),
+                    place: Place::NOWHERE,
                 });
                 self.grid.hold_balls(self.balls.len());
                 i
@@ -320,10 +391,7 @@ impl Region {
             self.grid.remove_from(i, b.cell);
             b.cell = NOWHERE;
         }
-        let queued = std::mem::replace(&mut b.queued, Key::at(f64::INFINITY, 0));
-        if queued.t.is_finite() {
-            self.queue.remove(&(queued, i));
-        }
+        self.unqueue(i);
     }
 
     /// Forgets ghost `gid` (it went out of reach).
@@ -433,19 +501,15 @@ impl Region {
         } else {
             b.phys.0.clone()
         };
-        let old = std::mem::replace(&mut b.queued, key.clone());
-        if old.t.is_finite() {
-            self.queue.remove(&(old, i));
-        }
-        if key.t.is_finite() {
-            self.queue.insert((key, i));
-        }
+        b.queued = key;
+        self.enqueue(i);
     }
 
     /// Runs every queued event at `key`: the batch of the region's wake-up at `key`.
     pub(super) fn run_due(&mut self, key: &Key, done: &mut Vec<Done>) {
         self.now = key.t;
-        while let Some((k, i)) = self.queue.first().cloned() {
+        while let Some(i) = self.first() {
+            let k = self.balls[i as usize].queued.clone();
             if k > *key {
                 break;
             }
