@@ -408,6 +408,7 @@ pub fn execute(
         engine.run(cfg.until, &mut sinks)?
     };
     let time_warp = engine.tw_stats();
+    let regions = engine.regions();
     engine.free();
     // every engine ends with a sweep of the state it ends in (a tunnelled ball has no event);
     // under MPI only rank 0 collects the final state
@@ -450,6 +451,7 @@ pub fn execute(
             .map(|cause| Interruption::new(outcome.t, cause)),
         observables: None,
         structure: None,
+        regions,
     };
     Ok(Report {
         outcome,

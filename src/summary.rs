@@ -48,6 +48,29 @@ pub struct RunSummary {
     /// g(r), the mean squared displacement and ψ6 at the sample times, when observed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub structure: Option<crate::structure::StructureFigures>,
+    /// The regions engine's layout and traffic, when it ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub regions: Option<RegionsSummary>,
+}
+
+/// How the regions engine cut the table and what crossed its borders.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RegionsSummary {
+    /// How many regions (strips of grid columns along x).
+    pub count: u32,
+    /// Grid columns of each strip, left to right.
+    pub columns: Vec<u32>,
+    /// Balls each region owned at the start.
+    pub balls_start: Vec<usize>,
+    /// Balls each region owned at the end.
+    pub balls_end: Vec<usize>,
+    /// Physical events run by two regions: collisions across a border.
+    pub events_across: u64,
+    /// Their fraction of all physical events.
+    pub fraction_across: f64,
+    /// Messages sent, by type: `Wake` (a region's own next event), `GhostEnter`,
+    /// `GhostUpdate`, `GhostLeave`, `Handover`, and `Cancel`.
+    pub messages: BTreeMap<String, u64>,
 }
 
 /// An interrupted run: the time it stopped at, every event up to it done, and the cause.
@@ -288,6 +311,7 @@ mod tests {
             interrupted: None,
             observables: None,
             structure: None,
+            regions: None,
         };
         let text = serde_json::to_string(&s).unwrap();
         assert!(

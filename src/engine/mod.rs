@@ -379,6 +379,10 @@ pub trait Engine {
     fn tw_stats(&self) -> Option<pdes_kernel::time_warp::TwStats> {
         None
     }
+    /// The regions engine's layout and traffic (other engines: `None`).
+    fn regions(&self) -> Option<crate::summary::RegionsSummary> {
+        None
+    }
 
     /// Frees the engine's memory (Time Warp's on each worker's own thread).
     fn free(self: Box<Self>) {}

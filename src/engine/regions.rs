@@ -5,14 +5,20 @@
 use super::{BallState, EventCounts, InstantCap, Observer, Outcome, RunError, Table, World};
 use crate::model::regions::{Region, Regions, RegionsError};
 use crate::scenario::{BallSpec, Scenario};
+use crate::summary::RegionsSummary;
 use pdes_kernel::sequential::Sequential;
 use pdes_kernel::time_warp::threads::{total_workers, TimeWarp};
 use pdes_kernel::time_warp::{ObjectMap, TwConfig, TwStats};
 use pdes_kernel::{ExecError, Executor, Interrupt, Model, VTime};
+use std::collections::BTreeMap;
 
 /// The regions engine over one scenario.
 pub struct RegionsEngine {
     exec: Box<dyn Executor<Regions, RunError>>,
+    /// Balls each region owned at the start.
+    balls_start: Vec<usize>,
+    /// Committed events run by two regions, and all committed events, so far.
+    across: (u64, u64),
 }
 
 /// The committed regions as the balls they own, for observers.
@@ -62,6 +68,7 @@ impl RegionsEngine {
         tw: Option<TwConfig>,
     ) -> Result<RegionsEngine, RegionsError> {
         let (model, states) = Regions::new(s, count, start)?;
+        let balls_start = states.iter().map(Region::owned).collect();
         let start = VTime::start(start);
         let exec: Box<dyn Executor<Regions, RunError>> = match tw {
             None => Box::new(Sequential::new(model, states, start)),
@@ -74,7 +81,11 @@ impl RegionsEngine {
                 Box::new(TimeWarp::new(model, states, start, &map, cfg))
             }
         };
-        Ok(RegionsEngine { exec })
+        Ok(RegionsEngine {
+            exec,
+            balls_start,
+            across: (0, 0),
+        })
     }
 
     /// Every ball's state at `t` (after the last event), from the committed regions.
@@ -104,9 +115,13 @@ impl super::Engine for RegionsEngine {
         let n = self.exec.model().n_balls();
         let mut instant = InstantCap::new(n as usize);
         self.exec.observe_states(obs.reads_balls());
+        let across = &mut self.across;
         let ended = self
             .exec
-            .run(until, &mut |model: &Regions, states: &[Region], ev| {
+            .run(until, &mut |model: &Regions, states: &[Region], out| {
+                let ev = out.event;
+                across.0 += u64::from(out.across);
+                across.1 += 1;
                 instant.count(&ev)?;
                 counts.add(ev.kind);
                 let view = View {
@@ -153,6 +168,25 @@ impl super::Engine for RegionsEngine {
 
     fn tw_stats(&self) -> Option<TwStats> {
         self.exec.tw_stats()
+    }
+
+    fn regions(&self) -> Option<RegionsSummary> {
+        let states = self.exec.states();
+        let stats = self.exec.stats();
+        let mut messages: BTreeMap<String, u64> = (self.exec.model().kind_names().iter())
+            .enumerate()
+            .map(|(k, n)| (n.to_string(), stats.get(k)))
+            .collect();
+        messages.insert("Cancel".into(), stats.cancels);
+        Some(RegionsSummary {
+            count: states.len() as u32,
+            columns: states.iter().map(Region::strip_columns).collect(),
+            balls_start: self.balls_start.clone(),
+            balls_end: states.iter().map(Region::owned).collect(),
+            events_across: self.across.0,
+            fraction_across: self.across.0 as f64 / self.across.1.max(1) as f64,
+            messages,
+        })
     }
 
     fn free(self: Box<Self>) {

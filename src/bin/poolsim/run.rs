@@ -821,7 +821,7 @@ pub fn human_summary(s: &RunSummary) -> String {
             s.wall_seconds, s.setup_seconds, s.events_per_second
         ),
     ];
-    if !matches!(s.engine.as_str(), "event-list" | "time-step") {
+    if !matches!(s.engine.as_str(), "event-list" | "time-step" | "regions") {
         let m = &s.messages;
         lines.push(format!(
             "messages      {} (thesis table 5 total: NewVelocity {}, Collision {}, Cancel {}, \
@@ -833,6 +833,22 @@ pub fn human_summary(s: &RunSummary) -> String {
             m.VelocityChange,
             m.SectorEntry,
             m.SectorDeparture
+        ));
+    }
+    if let Some(r) = &s.regions {
+        let news: u64 = ["GhostEnter", "GhostUpdate", "GhostLeave", "Handover"]
+            .iter()
+            .map(|k| r.messages.get(*k).copied().unwrap_or(0))
+            .sum();
+        lines.push(format!(
+            "regions       {} strips of {:?} grid columns, balls {:?} at the start; {:.2} % of \
+             events across a border; {} messages between regions, {} wake-ups",
+            r.count,
+            r.columns,
+            r.balls_start,
+            100.0 * r.fraction_across,
+            news,
+            r.messages.get("Wake").copied().unwrap_or(0)
         ));
     }
     if let Some(tw) = &s.time_warp {

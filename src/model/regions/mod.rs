@@ -83,6 +83,15 @@ pub enum RegionMsg {
     News(News),
 }
 
+/// A physical event as a region reports it.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct RegionEvent {
+    /// The event.
+    pub event: Event,
+    /// Whether two regions ran it (a collision across a border).
+    pub across: bool,
+}
+
 /// The message types, by [`Model::kind`].
 const KINDS: [&str; 5] = [
     "Wake",
@@ -325,7 +334,7 @@ impl Model for Regions {
     type Time = Key;
     type Msg = RegionMsg;
     type State = Region;
-    type Output = Event;
+    type Output = RegionEvent;
     type Undo = Undo;
 
     fn kind_names(&self) -> &'static [&'static str] {

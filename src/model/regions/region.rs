@@ -10,7 +10,7 @@
 //! and follows it from cell to cell, but leaves everything else it meets to its owner, who
 //! sends its new course.
 
-use super::{Ghost, News, Shape};
+use super::{Ghost, News, RegionEvent, Shape};
 use crate::engine::calendar::{Calendar, Entries, Place};
 use crate::engine::grid::Grid;
 use crate::engine::{BallState, Event, EventKind, Fixed};
@@ -142,7 +142,7 @@ pub struct Region {
 /// it) and the news its neighbours must hear, in order.
 #[derive(Default)]
 pub(super) struct Done {
-    pub(super) event: Option<Event>,
+    pub(super) event: Option<RegionEvent>,
     pub(super) news: Vec<(u32, News)>,
 }
 
@@ -244,6 +244,19 @@ impl Region {
     /// The region's index.
     pub fn index(&self) -> u32 {
         self.shape.me
+    }
+
+    /// Grid columns of its strip.
+    pub fn strip_columns(&self) -> u32 {
+        self.shape.columns - 2
+    }
+
+    /// Balls it owns, pocketed ones included.
+    pub fn owned(&self) -> usize {
+        let me = self.shape.me;
+        (self.local.values())
+            .filter(|&&i| self.balls[i as usize].owner == me)
+            .count()
     }
 
     /// Ball `gid`'s state as last fixed, if this region owns it.
@@ -570,12 +583,13 @@ impl Region {
         // the region that runs it last (the higher index) reports it, so that both balls have
         // their new courses when an observer looks
         let reporter = ka.owner.max(kb.owner);
+        let across = ka.owner != kb.owner;
         self.turn(a, key, va);
         self.turn(b, key, vb);
         self.predict(a);
         self.predict(b);
         let mut done = Done {
-            event: (reporter == self.shape.me).then_some(event),
+            event: (reporter == self.shape.me).then_some(RegionEvent { event, across }),
             news: Vec::new(),
         };
         let (oa, ob) = (self.balls[a as usize].owner, self.balls[b as usize].owner);
@@ -588,12 +602,16 @@ impl Region {
     fn hit(&mut self, i: u32, f: u32, key: &Key) -> Done {
         let b = &self.balls[i as usize];
         let table = &self.shape.table;
+        let event = Event {
+            t: key.t,
+            kind: table.event_kind(f),
+            a: b.gid,
+            b: f,
+        };
         let mut done = Done {
-            event: Some(Event {
-                t: key.t,
-                kind: table.event_kind(f),
-                a: b.gid,
-                b: f,
+            event: Some(RegionEvent {
+                event,
+                across: false,
             }),
             news: Vec::new(),
         };
