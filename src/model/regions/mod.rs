@@ -32,9 +32,10 @@
 //! the committed events, their order and the final state are bit-identical to the event
 //! list's for any number of regions, on any executor.
 
+mod events;
 mod region;
 
-pub use region::{Known, Region, Undo};
+pub use region::{Cold, Region, Slot, Undo};
 
 use crate::engine::grid::Grid;
 use crate::engine::{BallState, Event, Table};
@@ -121,15 +122,10 @@ pub struct Shape {
 
 impl Shape {
     /// The neighbours that keep a ball in grid column `col` as a ghost.
-    fn facing(&self, col: u32) -> Vec<u32> {
-        let mut out = Vec::new();
-        if let Some(l) = self.left.filter(|_| col <= 1) {
-            out.push(l);
-        }
-        if let Some(r) = self.right.filter(|_| col + 2 >= self.columns) {
-            out.push(r);
-        }
-        out
+    fn facing(&self, col: u32) -> impl Iterator<Item = u32> {
+        let left = self.left.filter(|_| col <= 1);
+        let right = self.right.filter(|_| col + 2 >= self.columns);
+        left.into_iter().chain(right)
     }
 
     /// The neighbour whose strip column `col` is (a halo column), if any.
@@ -265,7 +261,7 @@ impl Regions {
                     left: k.checked_sub(1),
                     right: (k + 1 < count).then_some(k + 1),
                 };
-                Region::new(Arc::new(shape), 0, start)
+                Region::new(Arc::new(shape), start)
             })
             .collect();
         let region_of = |c: u32| cuts.partition_point(|&x| x <= c) as u32 - 1;
@@ -290,7 +286,7 @@ impl Regions {
             }
         }
         for r in &mut regions {
-            for i in 0..r.balls.len() as u32 {
+            for i in 0..r.slots.len() as u32 {
                 r.predict(i);
             }
             r.settle(start);
@@ -377,15 +373,12 @@ impl Model for Regions {
         }
         if woken {
             state.set_wake(None);
-            let mut done = Vec::new();
-            state.run_due(&now.key, &mut done);
-            for d in done {
-                if let Some(ev) = d.event {
-                    ctx.emit(ev);
-                }
-                for (to, news) in d.news {
-                    ctx.send_now(to, RegionMsg::News(news));
-                }
+            state.run_due(&now.key);
+            for ev in state.reports.drain(..) {
+                ctx.emit(ev);
+            }
+            for (to, news) in state.outbox.drain(..) {
+                ctx.send_now(to, RegionMsg::News(news));
             }
         }
         self.schedule(ctx, state);
