@@ -365,6 +365,14 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
         self.journal.is_some()
     }
 
+    /// The records of old values this batch keeps, when it keeps them: for a model that
+    /// writes many records and would rather push them itself (or swap in a vector it filled)
+    /// than hand each to [`Ctx::save`]. The same rules hold: every record before the change it
+    /// undoes, in the order of the changes.
+    pub fn journal(&mut self) -> Option<&mut Vec<M::Undo>> {
+        self.journal.as_deref_mut()
+    }
+
     /// The object handling the batch.
     pub fn me(&self) -> u32 {
         self.me

@@ -363,7 +363,7 @@ impl Model for Regions {
         batch: &[Envelope<RegionMsg>],
     ) {
         let now = ctx.now().clone();
-        state.begin(ctx.saves());
+        state.begin(ctx.journal());
         let mut woken = false;
         for env in batch {
             match &env.msg {
@@ -382,9 +382,7 @@ impl Model for Regions {
             }
         }
         self.schedule(ctx, state);
-        for undo in state.end() {
-            ctx.save(|| undo);
-        }
+        state.end(ctx.journal());
     }
 
     fn saving(&self, _obj: u32) -> Saving<Region, Undo> {

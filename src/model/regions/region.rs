@@ -199,16 +199,22 @@ impl Region {
         self.slots[i as usize].owner == self.shape.me
     }
 
-    /// Starts a batch: whether it keeps the old values of what it changes.
-    pub(super) fn begin(&mut self, journaling: bool) {
-        self.journaling = journaling;
+    /// Starts a batch that keeps the old values of what it changes in `journal` (the
+    /// executor's, swapped in until [`Region::end`]), or keeps none.
+    pub(super) fn begin(&mut self, journal: Option<&mut Vec<Undo>>) {
         self.kept.clear();
+        self.journaling = journal.is_some();
+        if let Some(j) = journal {
+            std::mem::swap(&mut self.journal, j);
+        }
     }
 
-    /// Ends a batch: the old values it kept, oldest first.
-    pub(super) fn end(&mut self) -> std::vec::Drain<'_, Undo> {
+    /// Ends a batch: gives the executor's journal back, with the old values it kept.
+    pub(super) fn end(&mut self, journal: Option<&mut Vec<Undo>>) {
+        if let Some(j) = journal.filter(|_| self.journaling) {
+            std::mem::swap(&mut self.journal, j);
+        }
         self.journaling = false;
-        self.journal.drain(..)
     }
 
     /// Keeps `undo` if the batch keeps old values.
