@@ -341,7 +341,8 @@ def run(
     """Runs a scenario to ``until`` (default: the scenario's own end) and returns its results.
 
     ``engine`` is ``"event-list"`` (the reference), ``"time-step"`` (needs ``dt``),
-    ``"objects"`` or ``"time-warp"`` (``workers`` threads); ``sectors`` (``"auto"`` or
+    ``"objects"``, ``"time-warp"`` (``workers`` threads) or ``"regions"`` (the event list cut
+    into one strip per worker; one worker runs them in turn); ``sectors`` (``"auto"`` or
     ``(nx, ny)``) runs the objects on a sectored table. ``check`` checks invariants at every
     event. ``balls``, ``seed``, ``area_fraction``, ``radius``, ``speed_max``, ``lattice``
     (``"triangular"`` or ``"square"``), ``temperature``, ``mixture`` (``(F, Q)``: a fraction F

@@ -125,7 +125,7 @@ fn engine_of(ask: &Ask) -> PyResult<EngineKind> {
     if ask.dt.is_some() && ask.engine != "time-step" {
         return refuse("dt");
     }
-    if ask.workers.is_some() && ask.engine != "time-warp" {
+    if ask.workers.is_some() && !matches!(ask.engine.as_str(), "time-warp" | "regions") {
         return refuse("workers");
     }
     Ok(match ask.engine.as_str() {
@@ -163,9 +163,27 @@ fn engine_of(ask: &Ask) -> PyResult<EngineKind> {
                 news: FixedNews::Near,
             }
         }
+        "regions" if sectors.is_some() => return refuse("sectors"),
+        "regions" => {
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let workers = match ask.workers {
+                Some(w) if (1..=1024).contains(&w) => w,
+                Some(w) => return Err(value_error(format!("workers: must be 1 to 1024, got {w}"))),
+                None => cores,
+            };
+            // one region per worker; one worker runs them on the sequential executor
+            let tw = (workers > 1).then(|| pdes_kernel::time_warp::TwConfig {
+                workers,
+                ..Default::default()
+            });
+            EngineKind::Regions {
+                count: workers as u32,
+                tw,
+            }
+        }
         other => {
             return Err(value_error(format!(
-                "engine: one of event-list, time-step, objects, time-warp; got {other:?}"
+                "engine: one of event-list, time-step, objects, time-warp, regions; got {other:?}"
             )))
         }
     })

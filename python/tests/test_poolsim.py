@@ -41,6 +41,8 @@ def test_the_readme_line_gives_the_command_lines_digest():
         ("objects", {"sectors": (2, 3)}),
         ("time-warp", {"workers": 2}),
         ("time-warp", {"workers": 3, "sectors": "auto"}),
+        ("regions", {"workers": 1}),
+        ("regions", {"workers": 2}),
     ],
 )
 def test_every_engine_ends_in_the_event_lists_state(engine, extra):
