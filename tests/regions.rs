@@ -29,7 +29,14 @@ fn fits(s: &Scenario, count: u32) -> bool {
 /// Runs `s` on the event list and on `engines`, and asserts every trace and digest equal;
 /// returns how many of `engines` the table had columns for.
 fn assert_same(s: &Scenario, engines: &[EngineKind]) -> usize {
-    let (want, want_sum) = traced(s, EngineKind::EventList, true);
+    assert_same_checked(s, engines, true)
+}
+
+/// [`assert_same`], the runs checked at every event if `check` (observers that read the balls
+/// make every region's event a batch of its own; without them a batch runs on to the next
+/// message).
+fn assert_same_checked(s: &Scenario, engines: &[EngineKind], check: bool) -> usize {
+    let (want, want_sum) = traced(s, EngineKind::EventList, check);
     let mut ran = 0;
     for &engine in engines {
         let EngineKind::Regions { count, .. } = engine else {
@@ -38,7 +45,7 @@ fn assert_same(s: &Scenario, engines: &[EngineKind]) -> usize {
         if !fits(s, count) {
             continue;
         }
-        let (got, sum) = traced(s, engine, true);
+        let (got, sum) = traced(s, engine, check);
         assert_eq!(got, want, "{}: {engine:?}: traces differ", s.name);
         assert_eq!(
             sum.final_state_digest, want_sum.final_state_digest,
@@ -82,6 +89,34 @@ fn every_builtin_is_exact() {
         let ran = assert_same(&s, &settings());
         assert!(ran >= 5, "{name}: only {ran} settings had columns enough");
     }
+}
+
+#[test]
+fn batches_that_run_on_to_the_next_message_are_exact() {
+    for (name, balls) in [
+        ("gas", 2000),
+        ("pool", 0),
+        ("implosion", 500),
+        ("disks", 2000),
+    ] {
+        let mut p = builtin::Params::default();
+        if balls > 0 {
+            p.balls = Some(balls);
+        }
+        let mut s = builtin::build(name, &p).unwrap();
+        s.until = s.until.min(3.0);
+        let engines = [
+            regions(1, 1, None),
+            regions(3, 1, None),
+            regions(4, 2, Some(5)),
+        ];
+        let ran = assert_same_checked(&s, &engines, false);
+        assert_eq!(ran, 3, "{name}");
+    }
+    // one region on one worker runs the whole run as one batch
+    let s = builtin::build("gas", &builtin::Params::default()).unwrap();
+    let (_, sum) = traced(&s, regions(1, 1, None), false);
+    assert_eq!(sum.engine_stats["batches"], 1.0);
 }
 
 #[test]

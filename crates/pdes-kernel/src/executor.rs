@@ -85,6 +85,10 @@ impl<M: Model, E> Executor<M, E> for Sequential<M> {
         Sequential::pending_len(self)
     }
 
+    fn observe_states(&mut self, on: bool) {
+        Sequential::observe_states(self, on);
+    }
+
     fn stop_on(&mut self, interrupt: Interrupt) {
         Sequential::stop_on(self, interrupt);
     }

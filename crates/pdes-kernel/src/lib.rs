@@ -303,6 +303,21 @@ pub struct Ctx<'a, M: Model + ?Sized> {
     /// A send into the past this speculative batch tried (and that was dropped), or one sooner
     /// than the model's lookahead: a model bug if the batch commits.
     pub into_past: Option<String>,
+    /// How far the batch may run the object's own events past its time, when the executor
+    /// lets it ([`Ctx::may_run`]).
+    horizon: Option<Horizon<M::Time>>,
+    /// The time of the last of its own events the batch ran ([`Ctx::reach`]).
+    pub reached: Option<VTime<M::Time>>,
+}
+
+/// How far a batch may run its object's own events: before the first message still to come
+/// to any object, and not after the run's end.
+#[derive(Clone, Debug)]
+pub struct Horizon<T> {
+    /// The first message still to come (none: no message is waiting).
+    pub before: Option<VTime<T>>,
+    /// The run's end.
+    pub until: f64,
 }
 
 impl<'a, M: Model + ?Sized> Ctx<'a, M> {
@@ -320,7 +335,40 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             journal: None,
             speculative: false,
             into_past: None,
+            horizon: None,
+            reached: None,
         }
+    }
+
+    /// Lets the batch run its object's own events up to `horizon` ([`Ctx::may_run`]): for an
+    /// executor that runs every batch in order and whose sink does not read states between
+    /// outputs.
+    pub fn with_horizon(mut self, horizon: Horizon<M::Time>) -> Ctx<'a, M> {
+        self.horizon = Some(horizon);
+        self
+    }
+
+    /// Whether the batch may go on to run one of its object's own events (one that needs no
+    /// message to happen, such as the next event of a region's queue) at `time`, after the
+    /// batch's own: only where the executor allows it, before every message still to come and
+    /// every message this batch sent (its reply may come at once), and not after the run's
+    /// end. The handler then says how far it got with [`Ctx::reach`]. Under any other
+    /// executor, never: each such event waits for a batch of its own.
+    pub fn may_run(&self, time: &VTime<M::Time>) -> bool {
+        let Some(h) = &self.horizon else {
+            return false;
+        };
+        *time > self.now
+            && time.t() <= h.until
+            && h.before.as_ref().is_none_or(|b| time < b)
+            && self.sent.iter().all(|p| *time < p.time)
+    }
+
+    /// Records that the batch ran its object's own events up to `time`, as
+    /// [`Ctx::may_run`] allowed: the executor's clock moves on there.
+    pub fn reach(&mut self, time: VTime<M::Time>) {
+        debug_assert!(self.may_run(&time), "ran past the horizon");
+        self.reached = Some(time);
     }
 
     /// A context for a batch that may run on an inconsistent state (Time Warp): a send into

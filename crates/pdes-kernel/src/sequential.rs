@@ -3,7 +3,7 @@
 use super::prefetch::{prefetch, prefetch_all};
 use super::queue::{Queue, Ranked};
 use super::{
-    Ctx, Envelope, Handle, MessageStats, Model, Pending, Time, VTime, RESERVED_PER_OBJECT,
+    Ctx, Envelope, Handle, Horizon, MessageStats, Model, Pending, Time, VTime, RESERVED_PER_OBJECT,
 };
 use crate::Interrupt;
 use rustc_hash::FxHashSet;
@@ -117,6 +117,9 @@ pub struct Sequential<M: Model> {
     retracted: Vec<Handle>,
     /// Asks the run to end early.
     interrupt: Option<Interrupt>,
+    /// Whether the sink reads the states after each batch: a batch then runs no events of its
+    /// object's own beyond its time ([`Ctx::may_run`]).
+    observed: bool,
 }
 
 impl<M: Model> Sequential<M> {
@@ -136,6 +139,7 @@ impl<M: Model> Sequential<M> {
             sent: Vec::new(),
             retracted: Vec::new(),
             interrupt: None,
+            observed: true,
         };
         for me in 0..s.states.len() as u32 {
             let mut ctx = Ctx::new(&s.model, start.clone(), me, &mut s.seqs[me as usize]);
@@ -198,6 +202,12 @@ impl<M: Model> Sequential<M> {
         self.interrupt = Some(interrupt);
     }
 
+    /// Whether the sink reads the states just after each batch (the default). When it does
+    /// not, a batch may run its object's own events on to the next message ([`Ctx::may_run`]).
+    pub fn observe_states(&mut self, on: bool) {
+        self.observed = on;
+    }
+
     /// Runs every batch with time at most `until`, passing each output, with the states after
     /// the batch that produced it, to `sink`; stops at the first error the sink returns.
     /// Returns the time the run ended at: `until`, or an earlier one where an interrupt
@@ -238,6 +248,10 @@ impl<M: Model> Sequential<M> {
             self.stats.batches += 1;
             self.stats.delivered += batch.len() as u64;
             let mut ctx = Ctx::new(&self.model, time.clone(), to, &mut self.seqs[to as usize]);
+            if !self.observed {
+                let before = self.pending.peek().map(|Item(p)| p.time.clone());
+                ctx = ctx.with_horizon(Horizon { before, until });
+            }
             ctx.sent = std::mem::take(&mut self.sent);
             ctx.cancelled = std::mem::take(&mut self.retracted);
             self.model
@@ -245,6 +259,7 @@ impl<M: Model> Sequential<M> {
             batch.clear();
             self.batch = batch;
             let (mut sent, mut cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
+            let time = ctx.reached.unwrap_or(time);
             for h in cancelled.drain(..) {
                 self.stats.cancels += 1;
                 self.cancelled.insert(h);
@@ -305,6 +320,67 @@ mod tests {
             }
             *reminder = Some(ctx.send_at(me, VTime::start(t + 1e6), false));
             ctx.send_at(me, VTime::start(t + 1.0), true);
+        }
+    }
+
+    /// Object 0 ticks at every whole time, each tick an event of its own that needs no
+    /// message; object 1 sends it a message at 2.5. Ticks are reported with their times.
+    struct Ticker;
+
+    impl Model for Ticker {
+        type Time = PlainTime;
+        type Msg = ();
+        type State = f64;
+        type Output = f64;
+        type Undo = ();
+
+        fn kind_names(&self) -> &'static [&'static str] {
+            &["Poke"]
+        }
+        fn kind(&self, _: &()) -> usize {
+            0
+        }
+        fn priority(&self, _: &()) -> u8 {
+            0
+        }
+        fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, _: &mut f64) {
+            let t = if me == 0 { 1.0 } else { 2.5 };
+            ctx.send_at(me, VTime::start(t), ());
+        }
+        fn handle(&self, ctx: &mut Ctx<'_, Self>, me: u32, next: &mut f64, _: &[Envelope<()>]) {
+            let now = ctx.now().t();
+            if me == 1 {
+                return ctx.send_now(0, ());
+            }
+            if now < *next {
+                // the poke: its time reported, the next tick still to come
+                return ctx.emit(-now);
+            }
+            ctx.emit(now);
+            *next = now + 1.0;
+            while ctx.may_run(&VTime::start(*next)) {
+                ctx.emit(*next);
+                ctx.reach(VTime::start(*next));
+                *next += 1.0;
+            }
+            ctx.send_at(0, VTime::start(*next), ());
+        }
+    }
+
+    #[test]
+    fn a_batch_runs_its_own_events_on_to_the_next_message_only_when_unobserved() {
+        for observed in [true, false] {
+            let mut s = Sequential::new(Ticker, vec![1.0, 0.0], VTime::start(0.0));
+            s.observe_states(observed);
+            let mut out = Vec::new();
+            s.run(5.0, &mut |_, _, t| {
+                out.push(t);
+                Ok::<(), ()>(())
+            })
+            .unwrap();
+            assert_eq!(out, [1.0, 2.0, -2.5, 3.0, 4.0, 5.0], "observed {observed}");
+            let batches = if observed { 7 } else { 4 };
+            assert_eq!(s.stats().batches, batches, "observed {observed}");
         }
     }
 
