@@ -31,7 +31,11 @@ pub struct BenchOptions {
     /// Ball counts for Time Warp (on each of `tw_workers`) against the sequential objects
     /// engine: whole runs of the sectored gas until `tw_until`, set-up included.
     pub tw_balls: Vec<usize>,
-    /// Worker counts of the Time Warp and PHOLD rows.
+    /// Ball counts for the regions engine (on each of `tw_workers`, four regions per worker,
+    /// one on one worker) against the event list: whole runs of the gas at area fraction 0.5
+    /// until `tw_until`, set-up included.
+    pub regions_balls: Vec<usize>,
+    /// Worker counts of the Time Warp, regions and PHOLD rows.
     pub tw_workers: Vec<usize>,
     /// Simulated time of the Time Warp runs.
     pub tw_until: f64,
@@ -63,6 +67,8 @@ pub struct BenchReport {
     pub sectored: Vec<ObjectsRow>,
     /// Time Warp against the sequential objects engine.
     pub time_warp: Vec<TwRow>,
+    /// The regions engine against the event list (workers 0).
+    pub regions: Vec<TwRow>,
     /// PHOLD on the sequential kernel, then on each worker count.
     pub phold: Vec<PholdReport>,
     /// ROSS's published PHOLD record per core, for comparison.
@@ -79,6 +85,8 @@ pub enum Part {
     /// The Time Warp rows: a program that runs the objects engines without transparent huge
     /// pages ([`crate::memory`]) turns them off here.
     TimeWarp,
+    /// The regions engine's rows.
+    Regions,
     /// PHOLD on the kernel.
     Phold,
 }
@@ -99,6 +107,8 @@ pub enum Measured<'a> {
     Sectored(&'a ObjectsRow),
     /// A Time Warp row.
     TimeWarp(&'a TwRow),
+    /// A regions engine row (workers 0: the event list).
+    Regions(&'a TwRow),
     /// A PHOLD run.
     Phold(&'a PholdReport),
 }
@@ -169,9 +179,10 @@ pub enum BenchError {
         /// The sequential kernel's.
         sequential: String,
     },
-    /// Time Warp ended in another state than the sequential objects engine.
+    /// A parallel run (Time Warp, or the regions engine) ended in another state than its
+    /// sequential baseline.
     #[error(
-        "bench: Time Warp on {workers} workers ended in state {digest}, the sequential engine \
+        "bench: the run on {workers} workers ended in state {digest}, the sequential baseline \
          in {sequential} ({balls} balls until {until})"
     )]
     TimeWarpDigest {
@@ -394,6 +405,7 @@ fn validate(a: &BenchOptions) -> Result<usize, BenchError> {
         ("--objects-balls", &a.objects_balls),
         ("--sectored-balls", &a.sectored_balls),
         ("--tw-balls", &a.tw_balls),
+        ("--regions-balls", &a.regions_balls),
     ] {
         if counts.contains(&0) {
             return Err(BenchError::NoBalls { flag });
@@ -471,6 +483,18 @@ pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchRepo
             time_warp.push(r);
         }
     }
+    each(Measured::Starting(Part::Regions));
+    let mut regions = Vec::new();
+    for &n in &a.regions_balls {
+        let mut runs = Vec::new();
+        for _ in 0..a.repeat.max(1) {
+            runs.push(measure_regions(n, a.tw_until, a.tw_pure, &a.tw_workers)?);
+        }
+        for r in fastest_rows(runs) {
+            each(Measured::Regions(&r));
+            regions.push(r);
+        }
+    }
     each(Measured::Starting(Part::Phold));
     let phold = measure_phold(a, partitions as u32, each)?;
     Ok(BenchReport {
@@ -481,6 +505,7 @@ pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchRepo
         objects,
         sectored,
         time_warp,
+        regions,
         phold,
         phold_ross_events_per_second_per_core: ROSS_EVENTS_PER_SECOND_PER_CORE,
     })
@@ -648,26 +673,69 @@ pub fn measure_time_warp(
     pure: bool,
     workers: &[usize],
 ) -> Result<Vec<TwRow>, BenchError> {
-    use crate::run::{execute, EngineKind, FixedNews, RunConfig, SectorChoice};
-    let (n_balls, scenario) = (balls, thesis_gas(balls, None)?);
-    let mut rows: Vec<TwRow> = Vec::new();
-    for workers in std::iter::once(0).chain(workers.iter().copied()) {
-        let engine = match workers {
+    use crate::run::{EngineKind, FixedNews, SectorChoice};
+    let engines = std::iter::once(0).chain(workers.iter().copied()).map(|w| {
+        let engine = match w {
             0 => EngineKind::Sectored {
                 sectors: SectorChoice::Auto,
                 news: FixedNews::default(),
             },
             w => EngineKind::TimeWarp {
-                tw: pdes_kernel::time_warp::TwConfig {
-                    workers: w,
-                    final_batches: !pure,
-                    ..Default::default()
-                },
+                tw: tw_config(w, pure),
                 delay: crate::model::pool::NvDelay::Exact,
                 sectors: Some(SectorChoice::Auto),
                 news: FixedNews::default(),
             },
         };
+        (w, engine)
+    });
+    timed_rows(&thesis_gas(balls, None)?, until, engines)
+}
+
+/// Runs the gas of `balls` balls at area fraction 0.5 until `until` on the event list and on
+/// the regions engine on each of `workers` (four regions per worker, one on one worker;
+/// `pure`: no batch run as final); fails if any digest differs.
+pub fn measure_regions(
+    balls: usize,
+    until: f64,
+    pure: bool,
+    workers: &[usize],
+) -> Result<Vec<TwRow>, BenchError> {
+    use crate::run::EngineKind;
+    let engines = std::iter::once(0).chain(workers.iter().copied()).map(|w| {
+        let engine = match w {
+            0 => EngineKind::EventList,
+            1 => EngineKind::Regions { count: 1, tw: None },
+            w => EngineKind::Regions {
+                count: 4 * w as u32,
+                tw: Some(tw_config(w, pure)),
+            },
+        };
+        (w, engine)
+    });
+    timed_rows(&thesis_gas(balls, Some(0.5))?, until, engines)
+}
+
+/// Time Warp on `workers` workers (`pure`: no batch runs as final).
+fn tw_config(workers: usize, pure: bool) -> pdes_kernel::time_warp::TwConfig {
+    pdes_kernel::time_warp::TwConfig {
+        workers,
+        final_batches: !pure,
+        ..Default::default()
+    }
+}
+
+/// Runs `scenario` until `until` on each of `engines` (with its worker count, 0 for the
+/// baseline, which comes first), whole runs; fails if a digest differs from the first's.
+fn timed_rows(
+    scenario: &crate::scenario::Scenario,
+    until: f64,
+    engines: impl Iterator<Item = (usize, crate::run::EngineKind)>,
+) -> Result<Vec<TwRow>, BenchError> {
+    use crate::run::{execute, RunConfig};
+    let n_balls = scenario.balls.len();
+    let mut rows: Vec<TwRow> = Vec::new();
+    for (workers, engine) in engines {
         let cfg = RunConfig {
             engine,
             until,
@@ -677,7 +745,7 @@ pub fn measure_time_warp(
             checkpoint_every: None,
             thermostat: None,
         };
-        let report = execute(&scenario, &cfg, &mut Ignore)?;
+        let report = execute(scenario, &cfg, &mut Ignore)?;
         let s = &report.summary;
         let tw = s.time_warp.as_ref();
         let digest = s.final_state_digest.clone();

@@ -46,7 +46,16 @@ pub struct BenchArgs {
     /// included.
     #[arg(long = "tw-balls", value_delimiter = ',', default_value = "9801")]
     pub tw_balls: Vec<usize>,
-    /// Worker counts of the Time Warp and PHOLD rows.
+    /// Ball counts for the regions engine (on each of `--tw-workers`, four regions per worker,
+    /// one on one worker) against the event list: whole runs of the gas at area fraction 0.5
+    /// until `--tw-until`, set-up included.
+    #[arg(
+        long = "regions-balls",
+        value_delimiter = ',',
+        default_value = "100000"
+    )]
+    pub regions_balls: Vec<usize>,
+    /// Worker counts of the Time Warp, regions and PHOLD rows.
     #[arg(long = "tw-workers", value_delimiter = ',', default_value = "1,2")]
     pub tw_workers: Vec<usize>,
     /// Simulated time of the Time Warp runs.
@@ -82,6 +91,7 @@ impl BenchArgs {
             objects_balls: self.objects_balls.clone(),
             sectored_balls: self.sectored_balls.clone(),
             tw_balls: self.tw_balls.clone(),
+            regions_balls: self.regions_balls.clone(),
             tw_workers: self.tw_workers.clone(),
             tw_until: self.tw_until,
             tw_pure: self.tw_pure,
@@ -98,7 +108,10 @@ pub fn bench(a: &BenchArgs) -> Result<(), Failure> {
     let report = bench::run(&a.options(), &mut |m| {
         // Time Warp runs without transparent huge pages, as `poolsim run` runs it
         if let Measured::Starting(part) = m {
-            poolsim::memory::transparent_huge_pages(part != Part::TimeWarp);
+            poolsim::memory::transparent_huge_pages(!matches!(
+                part,
+                Part::TimeWarp | Part::Regions
+            ));
         }
         if !a.json {
             table.print(m);
@@ -168,6 +181,7 @@ impl<'a> Table<'a> {
                 objects_header();
             }
             "time_warp" => time_warp_header(self.args),
+            "regions" => regions_header(self.args),
             _ => println!(
                 "PHOLD beside ROSS's published record, {:.2} M committed events/s per core (504 \
                  billion/s on 1,966,080 Blue Gene/Q cores; Barnes et al., PADS 2013):",
@@ -213,6 +227,10 @@ impl<'a> Table<'a> {
                 self.head("time_warp");
                 time_warp_row(r);
             }
+            Measured::Regions(r) => {
+                self.head("regions");
+                time_warp_row(r);
+            }
             Measured::Phold(p) => {
                 self.head("phold");
                 phold_row(p);
@@ -248,6 +266,11 @@ fn time_warp_header(a: &BenchArgs) {
          speed-ups within each turn)",
         a.tw_until, a.repeat
     );
+    parallel_columns();
+}
+
+/// The columns of the Time Warp and regions rows.
+fn parallel_columns() {
     println!(
         "{:>9} {:>8} {:>9} {:>9} {:>9} {:>7} {:>11} {:>8} {:>6}  digest",
         "balls",
@@ -260,6 +283,16 @@ fn time_warp_header(a: &BenchArgs) {
         "remote",
         "final"
     );
+}
+
+fn regions_header(a: &BenchArgs) {
+    println!(
+        "the regions engine against the event list (seq): gas at area fraction 0.5 until {}, \
+         four regions per worker (one on one worker), whole runs, each engine's fastest of {} \
+         run in turn",
+        a.tw_until, a.repeat
+    );
+    parallel_columns();
 }
 
 fn time_warp_row(r: &TwRow) {
