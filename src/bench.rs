@@ -471,30 +471,28 @@ pub fn run(a: &BenchOptions, each: &mut dyn FnMut(Measured)) -> Result<BenchRepo
         each(Measured::Sectored(&r));
         sectored.push(r);
     }
-    each(Measured::Starting(Part::TimeWarp));
-    let mut time_warp = Vec::new();
-    for &n in &a.tw_balls {
-        let mut runs = Vec::new();
-        for _ in 0..a.repeat.max(1) {
-            runs.push(measure_time_warp(n, a.tw_until, a.tw_pure, &a.tw_workers)?);
-        }
-        for r in fastest_rows(runs) {
-            each(Measured::TimeWarp(&r));
-            time_warp.push(r);
-        }
-    }
-    each(Measured::Starting(Part::Regions));
-    let mut regions = Vec::new();
-    for &n in &a.regions_balls {
-        let mut runs = Vec::new();
-        for _ in 0..a.repeat.max(1) {
-            runs.push(measure_regions(n, a.tw_until, a.tw_pure, &a.tw_workers)?);
-        }
-        for r in fastest_rows(runs) {
-            each(Measured::Regions(&r));
-            regions.push(r);
-        }
-    }
+    // each ball count's repetitions, the fastest row of each worker count reported
+    let mut parallel_rows =
+        |balls: &[usize], part: Part, measure: MeasureParallel| -> Result<Vec<TwRow>, BenchError> {
+            each(Measured::Starting(part));
+            let mut rows = Vec::new();
+            for &n in balls {
+                let mut runs = Vec::new();
+                for _ in 0..a.repeat.max(1) {
+                    runs.push(measure(n, a.tw_until, a.tw_pure, &a.tw_workers)?);
+                }
+                for r in fastest_rows(runs) {
+                    each(match part {
+                        Part::Regions => Measured::Regions(&r),
+                        _ => Measured::TimeWarp(&r),
+                    });
+                    rows.push(r);
+                }
+            }
+            Ok(rows)
+        };
+    let time_warp = parallel_rows(&a.tw_balls, Part::TimeWarp, measure_time_warp)?;
+    let regions = parallel_rows(&a.regions_balls, Part::Regions, measure_regions)?;
     each(Measured::Starting(Part::Phold));
     let phold = measure_phold(a, partitions as u32, each)?;
     Ok(BenchReport {
@@ -691,6 +689,10 @@ pub fn measure_time_warp(
     });
     timed_rows(&thesis_gas(balls, None)?, until, engines)
 }
+
+/// Measures a parallel engine against its sequential baseline: balls, simulated time, pure
+/// Time Warp, worker counts; the baseline's row first.
+type MeasureParallel = fn(usize, f64, bool, &[usize]) -> Result<Vec<TwRow>, BenchError>;
 
 /// Runs the gas of `balls` balls at area fraction 0.5 until `until` on the event list and on
 /// the regions engine on each of `workers` (four regions per worker, one on one worker;

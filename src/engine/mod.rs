@@ -331,6 +331,17 @@ impl BallState {
     }
 }
 
+/// A kernel model's messages sent so far, by type name, and the cancellations (`Cancel`).
+pub fn message_counts<M: pdes_kernel::Model>(
+    model: &M,
+    stats: &pdes_kernel::MessageStats,
+) -> Vec<(&'static str, u64)> {
+    let names = model.kind_names().iter().enumerate();
+    let mut counts: Vec<(&'static str, u64)> = names.map(|(k, n)| (*n, stats.get(k))).collect();
+    counts.push(("Cancel", stats.cancels));
+    counts
+}
+
 /// A read-only view of an engine's state between events, for invariant checks.
 pub trait World {
     /// The table.

@@ -256,14 +256,7 @@ where
         })
         .collect();
     let stats = e.stats();
-    let mut messages: Vec<(&'static str, u64)> = e
-        .model()
-        .kind_names()
-        .iter()
-        .enumerate()
-        .map(|(k, n)| (*n, stats.get(k)))
-        .collect();
-    messages.push(("Cancel", stats.cancels));
+    let messages = super::message_counts(e.model(), stats);
     Outcome {
         t: until,
         balls,

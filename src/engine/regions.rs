@@ -9,7 +9,7 @@ use crate::summary::RegionsSummary;
 use pdes_kernel::sequential::Sequential;
 use pdes_kernel::time_warp::threads::{total_workers, TimeWarp};
 use pdes_kernel::time_warp::{ObjectMap, TwConfig, TwStats};
-use pdes_kernel::{ExecError, Executor, Interrupt, Model, VTime};
+use pdes_kernel::{ExecError, Executor, Interrupt, VTime};
 use std::collections::BTreeMap;
 
 /// The regions engine over one scenario.
@@ -136,15 +136,7 @@ impl super::Engine for RegionsEngine {
                 ExecError::Failed(m) => RunError::TimeWarp(m),
             })?;
         let stats = self.exec.stats();
-        let mut messages: Vec<(&'static str, u64)> = self
-            .exec
-            .model()
-            .kind_names()
-            .iter()
-            .enumerate()
-            .map(|(k, n)| (*n, stats.get(k)))
-            .collect();
-        messages.push(("Cancel", stats.cancels));
+        let messages = super::message_counts(self.exec.model(), stats);
         Ok(Outcome {
             t: ended,
             balls: self.balls_at(ended),
@@ -172,12 +164,11 @@ impl super::Engine for RegionsEngine {
 
     fn regions(&self) -> Option<RegionsSummary> {
         let states = self.exec.states();
-        let stats = self.exec.stats();
-        let mut messages: BTreeMap<String, u64> = (self.exec.model().kind_names().iter())
-            .enumerate()
-            .map(|(k, n)| (n.to_string(), stats.get(k)))
-            .collect();
-        messages.insert("Cancel".into(), stats.cancels);
+        let messages: BTreeMap<String, u64> =
+            super::message_counts(self.exec.model(), self.exec.stats())
+                .into_iter()
+                .map(|(k, n)| (k.to_string(), n))
+                .collect();
         Some(RegionsSummary {
             count: states.len() as u32,
             columns: states.iter().map(Region::strip_columns).collect(),
