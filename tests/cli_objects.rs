@@ -226,7 +226,7 @@ fn phold_on_the_conservative_executor_gives_the_sequential_digest() {
     );
     bad(
         &["phold", "--engine", "conservative", "--tw-burst", "8"],
-        "--tw-burst: only the time-warp and regions engines take it",
+        "--tw-burst: only the time-warp engine takes it",
     );
 }
 

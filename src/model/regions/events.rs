@@ -19,7 +19,7 @@ use smallvec::SmallVec;
 use std::cmp::Ordering;
 
 /// The pair code of a ball leaving its cell: after every physical event of its instant.
-const CELL_CROSSING: u64 = u64::MAX;
+pub(super) const CELL_CROSSING: u64 = u64::MAX;
 
 /// The balls a prediction tests.
 type Near = SmallVec<[u32; 48]>;
@@ -143,32 +143,43 @@ impl Region {
         self.enqueue(i);
     }
 
-    /// Runs every queued event at `key`: the batch of the region's wake-up at `key`. What it
-    /// reports and tells the neighbours goes to the region's reports and outbox.
-    pub(super) fn run_due(&mut self, key: &Key) {
-        self.now = key.t;
+    /// Runs every queued event at `key` (the batch of the region's wake-up at `key`), then
+    /// the events after it while `more` allows each one's key and none has had news for a
+    /// neighbour. What they report and tell the neighbours goes to the region's reports and
+    /// outbox. The key of the last event run after `key`, if any.
+    pub(super) fn run_on(&mut self, key: &Key, mut more: impl FnMut(&Key) -> bool) -> Option<Key> {
+        let mut reached = None;
         while let Some(i) = self.first() {
             let k = self.cold[i as usize].queued.clone();
             if k > *key {
-                break;
-            }
-            debug_assert!(k == *key, "a region's event {k:?} was left behind {key:?}");
-            if k.path[..] == [CELL_CROSSING] {
-                self.cross(i);
-                continue;
-            }
-            match self.cold[i as usize].phys.1 {
-                Partner::Ball(j, seen) if self.slots[j as usize].counter == seen => {
-                    // two ghosts meet where their owner runs it
-                    if self.mine(i) || self.mine(j) {
-                        self.collide(i, j, &k);
-                    } else {
-                        self.predict(i);
-                    }
+                if !self.outbox.is_empty() || !more(&k) {
+                    break;
                 }
-                Partner::Fixed(f) => self.hit(i, f, &k),
-                Partner::Nothing | Partner::Ball(..) => self.predict(i),
+                reached = Some(k.clone());
             }
+            debug_assert!(k >= *key, "a region's event {k:?} was left behind {key:?}");
+            self.now = k.t;
+            self.run_one(i, &k);
+        }
+        reached
+    }
+
+    /// Runs record `i`'s queued event, at `k`.
+    fn run_one(&mut self, i: u32, k: &Key) {
+        if k.path[..] == [CELL_CROSSING] {
+            return self.cross(i);
+        }
+        match self.cold[i as usize].phys.1 {
+            Partner::Ball(j, seen) if self.slots[j as usize].counter == seen => {
+                // two ghosts meet where their owner runs it
+                if self.mine(i) || self.mine(j) {
+                    self.collide(i, j, k);
+                } else {
+                    self.predict(i);
+                }
+            }
+            Partner::Fixed(f) => self.hit(i, f, k),
+            Partner::Nothing | Partner::Ball(..) => self.predict(i),
         }
     }
 

@@ -373,18 +373,11 @@ impl Model for Regions {
         }
         if woken {
             state.set_wake(None);
-            state.run_due(&now.key);
             // on an executor that allows it, the region's own events up to the next message
             // run in this batch too, until one of them has news for a neighbour
-            while state.outbox.is_empty() {
-                let Some(next) = state.first_key().map(|k| VTime::at(k.clone())) else {
-                    break;
-                };
-                if !ctx.may_run(&next) {
-                    break;
-                }
-                state.run_due(&next.key);
-                ctx.reach(next);
+            let reached = state.run_on(&now.key, |k| ctx.may_run(&VTime::at(k.clone())));
+            if let Some(k) = reached {
+                ctx.reach(VTime::at(k));
             }
             for ev in state.reports.drain(..) {
                 ctx.emit(ev);

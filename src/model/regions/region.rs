@@ -4,6 +4,7 @@
 //!
 //! Its events (the event-list algorithm over these records) are in the `events` module.
 
+use super::events::CELL_CROSSING;
 use super::{Ghost, News, RegionEvent, Shape};
 use crate::engine::calendar::{Calendar, Entries, Place};
 use crate::engine::grid::Grid;
@@ -88,10 +89,11 @@ pub enum Undo {
     Wake(Option<(Key, Handle)>),
 }
 
-/// What the calendar sees of a region's records.
+/// What the calendar sees of a region's records, and the grid whose cells it prefetches.
 pub(super) struct Queued<'a> {
     slots: &'a [Slot],
     cold: &'a mut [Cold],
+    grid: &'a Grid,
 }
 
 impl Entries for Queued<'_> {
@@ -107,10 +109,40 @@ impl Entries for Queued<'_> {
     fn set_place(&mut self, i: u32, place: Place) {
         self.cold[i as usize].place = place;
     }
+    /// Its records start loading: they will be read at the next event.
     #[inline]
     fn opened(&self, i: u32) {
         prefetch_all(&self.cold[i as usize]);
         prefetch(&self.slots[i as usize]);
+    }
+    /// Its records have arrived: the partner's records and the cells its event reads start
+    /// loading.
+    #[inline]
+    fn approaching(&self, i: u32) {
+        let c = &self.cold[i as usize];
+        if c.queued.path[..] == [CELL_CROSSING] {
+            self.grid.prefetch_near(c.cross.1);
+        } else if let Partner::Ball(j, _) = c.phys.1 {
+            prefetch(&self.slots[j as usize]);
+            prefetch_all(&self.cold[j as usize]);
+            self.grid.prefetch_near(self.slots[i as usize].cell);
+        }
+    }
+    /// The cells have arrived: the slots of the balls in them start loading.
+    #[inline]
+    fn imminent(&self, i: u32) {
+        let (c, cell) = (&self.cold[i as usize], self.slots[i as usize].cell);
+        if cell == NOWHERE {
+            return;
+        }
+        if c.queued.path[..] == [CELL_CROSSING] {
+            let slots = self.slots;
+            (self.grid).for_each_entering(cell, c.cross.1, |j| prefetch(&slots[j as usize]));
+        } else if let Partner::Ball(j, _) = c.phys.1 {
+            let slots = self.slots;
+            (self.grid).for_each_near(cell, |k| prefetch(&slots[k as usize]));
+            self.grid.prefetch_near(self.slots[j as usize].cell);
+        }
     }
 }
 
@@ -299,6 +331,7 @@ impl Region {
         let entries = Queued {
             slots: &self.slots,
             cold: &mut self.cold,
+            grid: &self.grid,
         };
         (&mut self.queue, entries)
     }
