@@ -113,10 +113,23 @@ fn batches_that_run_on_to_the_next_message_are_exact() {
         let ran = assert_same_checked(&s, &engines, false);
         assert_eq!(ran, 3, "{name}");
     }
-    // one region on one worker runs the whole run as one batch
+    // one region on one worker runs a short run as one batch, a long one in batches of a few
+    // thousand events
     let s = builtin::build("gas", &builtin::Params::default()).unwrap();
     let (_, sum) = traced(&s, regions(1, 1, None), false);
     assert_eq!(sum.engine_stats["batches"], 1.0);
+    let p = builtin::Params {
+        balls: Some(4000),
+        ..Default::default()
+    };
+    let s = builtin::build("gas", &p).unwrap();
+    let (trace, sum) = traced(&s, regions(1, 1, None), false);
+    let batches = sum.engine_stats["batches"];
+    assert!(trace.len() > 10_000, "{} events", trace.len());
+    assert!(
+        batches > 1.0 && batches < trace.len() as f64 / 1000.0,
+        "{batches} batches"
+    );
 }
 
 #[test]

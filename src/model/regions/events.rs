@@ -21,6 +21,10 @@ use std::cmp::Ordering;
 /// The pair code of a ball leaving its cell: after every physical event of its instant.
 pub(super) const CELL_CROSSING: u64 = u64::MAX;
 
+/// The most queued events one batch runs: the batch's reports wait in memory until it ends, and
+/// an interrupt is seen between batches.
+const SPAN: usize = 4096;
+
 /// The balls a prediction tests.
 type Near = SmallVec<[u32; 48]>;
 
@@ -149,14 +153,16 @@ impl Region {
     /// outbox. The key of the last event run after `key`, if any.
     pub(super) fn run_on(&mut self, key: &Key, mut more: impl FnMut(&Key) -> bool) -> Option<Key> {
         let mut reached = None;
+        let mut run = 0;
         while let Some(i) = self.first() {
             let k = self.cold[i as usize].queued.clone();
             if k > *key {
-                if !self.outbox.is_empty() || !more(&k) {
+                if !self.outbox.is_empty() || run >= SPAN || !more(&k) {
                     break;
                 }
                 reached = Some(k.clone());
             }
+            run += 1;
             debug_assert!(k >= *key, "a region's event {k:?} was left behind {key:?}");
             self.now = k.t;
             self.run_one(i, &k);

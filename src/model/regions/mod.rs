@@ -374,7 +374,8 @@ impl Model for Regions {
         if woken {
             state.set_wake(None);
             // on an executor that allows it, the region's own events up to the next message
-            // run in this batch too, until one of them has news for a neighbour
+            // run in this batch too (a few thousand at most), until one of them has news for
+            // a neighbour
             let reached = state.run_on(&now.key, |k| ctx.may_run(&VTime::at(k.clone())));
             if let Some(k) = reached {
                 ctx.reach(VTime::at(k));
