@@ -4,7 +4,7 @@
 
 use super::{BallState, EventCounts, InstantCap, Observer, Outcome, RunError, Table, World};
 use crate::model::regions::{Region, Regions, RegionsError};
-use crate::scenario::{BallSpec, Scenario};
+use crate::scenario::Scenario;
 use crate::summary::RegionsSummary;
 use pdes_kernel::sequential::Sequential;
 use pdes_kernel::time_warp::threads::{total_workers, TimeWarp};
@@ -152,10 +152,6 @@ impl super::Engine for RegionsEngine {
 
     fn stop_on(&mut self, interrupt: Interrupt) {
         self.exec.stop_on(interrupt);
-    }
-
-    fn balls_to_take_up(&self) -> Option<Vec<BallSpec>> {
-        None
     }
 
     fn tw_stats(&self) -> Option<TwStats> {

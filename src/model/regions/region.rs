@@ -473,7 +473,7 @@ impl Region {
         }
     }
 
-    /// Record `i`'s local index of ball `gid`, if the region knows it.
+    /// The local index of ball `gid`, if the region knows it.
     pub(super) fn local_of(&self, gid: u32) -> Option<u32> {
         self.local.get(&gid).copied()
     }
