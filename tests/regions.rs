@@ -113,6 +113,20 @@ fn batches_that_run_on_to_the_next_message_are_exact() {
         let ran = assert_same_checked(&s, &engines, false);
         assert_eq!(ran, 3, "{name}");
     }
+    // under Time Warp too: a batch runs on past its time, and one that a neighbour's news
+    // reaches inside its span is cut back to the event before it, not undone whole
+    let p = builtin::Params {
+        balls: Some(4000),
+        ..Default::default()
+    };
+    let mut s = builtin::build("gas", &p).unwrap();
+    s.until = 2.0;
+    let engine = regions(2, 2, Some(7));
+    assert_eq!(assert_same_checked(&s, &[engine], false), 1);
+    let (_, sum) = traced(&s, engine, false);
+    let tw = sum.time_warp.expect("time warp ran").stats;
+    assert!(tw.ran_on > 10 * tw.committed, "{tw:?}");
+    assert!(tw.cuts > 0 && tw.ran_on_undone > 0, "{tw:?}");
     // one region on one worker runs a short run as one batch, a long one in batches of a few
     // thousand events
     let s = builtin::build("gas", &builtin::Params::default()).unwrap();

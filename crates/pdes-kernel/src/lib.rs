@@ -203,6 +203,22 @@ pub trait Model {
     fn lookahead(&self) -> f64 {
         0.0
     }
+    /// Whether object `obj`'s batches may run its own events on past their time
+    /// ([`Ctx::may_run`]) under Time Warp, which then keeps the times of the messages waiting
+    /// for the object to tell it how far. The answer must not change over a run.
+    fn runs_ahead(&self, obj: u32) -> bool {
+        let _ = obj;
+        false
+    }
+    /// Ends anew a batch of object `me` that ran its own events on ([`Ctx::may_run`]) and that
+    /// Time Warp has cut back to before one of them, because a message came for the object
+    /// there: `state` is as the batch left it before that event, `ctx.now()` is the last event
+    /// it kept (or its own time), and the handler sends (and cancels) what the batch would
+    /// have had it stopped there; it emits nothing. Only for objects that run ahead
+    /// ([`Model::runs_ahead`]).
+    fn cut(&self, ctx: &mut Ctx<'_, Self>, me: u32, state: &mut Self::State) {
+        let _ = (ctx, me, state);
+    }
     /// Sets object `me` up at the start time; it may send messages.
     fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, state: &mut Self::State);
     /// Runs object `me` over one batch of messages, all with the virtual time `ctx.now()`.
@@ -296,6 +312,9 @@ pub struct Ctx<'a, M: Model + ?Sized> {
     pub cancelled: Vec<Handle>,
     /// Output this batch produced.
     pub output: Vec<M::Output>,
+    /// The time of each output, when the batch ran its object's own events on
+    /// ([`Ctx::emit_at`]): empty while every output is at the batch's time.
+    pub output_times: Vec<VTime<M::Time>>,
     /// Where [`Ctx::save`] writes, when the executor keeps the batch's old values.
     journal: Option<&'a mut Vec<M::Undo>>,
     /// Set by an optimistic executor: a batch may run on a state that a rollback will undo.
@@ -308,6 +327,10 @@ pub struct Ctx<'a, M: Model + ?Sized> {
     horizon: Option<Horizon<M::Time>>,
     /// The time of the last of its own events the batch ran ([`Ctx::reach`]).
     pub reached: Option<VTime<M::Time>>,
+    /// Where each of its own events the batch ran on to starts in the journal, when it keeps
+    /// one: the event's time and the journal's length before it ([`Ctx::reach`]). An
+    /// optimistic executor undoes the batch back to one of them.
+    pub marks: Vec<(VTime<M::Time>, usize)>,
 }
 
 /// How far a batch may run its object's own events: before the first message still to come
@@ -332,11 +355,13 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             sent: Vec::new(),
             cancelled: Vec::new(),
             output: Vec::new(),
+            output_times: Vec::new(),
             journal: None,
             speculative: false,
             into_past: None,
             horizon: None,
             reached: None,
+            marks: Vec::new(),
         }
     }
 
@@ -354,6 +379,12 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     /// every message this batch sent (its reply may come at once), and not after the run's
     /// end. The handler then says how far it got with [`Ctx::reach`]. Under any other
     /// executor, never: each such event waits for a batch of its own.
+    ///
+    /// The events a batch runs on must send nothing but at its end: the model stops at the
+    /// first event with something to send and sends after [`Ctx::reach`] (a send is then at
+    /// or after the time reached). Time Warp relies on it: a batch rolled back for a message
+    /// inside its span runs again up to that message, and that shorter run sends nothing a
+    /// receiver could have seen, even one that has committed past the batch's start.
     pub fn may_run(&self, time: &VTime<M::Time>) -> bool {
         let Some(h) = &self.horizon else {
             return false;
@@ -364,11 +395,22 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             && self.sent.iter().all(|p| *time < p.time)
     }
 
-    /// Records that the batch ran its object's own events up to `time`, as
-    /// [`Ctx::may_run`] allowed: the executor's clock moves on there.
+    /// Records that the batch runs its object's own event at `time` next, as [`Ctx::may_run`]
+    /// allowed: the executor's clock moves on there. A model that keeps a journal calls it
+    /// before the event's first record (and before its first change), so that the executor
+    /// can undo the batch back to this event alone.
     pub fn reach(&mut self, time: VTime<M::Time>) {
         debug_assert!(self.may_run(&time), "ran past the horizon");
+        if let Some(j) = &self.journal {
+            self.marks.push((time.clone(), j.len()));
+        }
         self.reached = Some(time);
+    }
+
+    /// The time the batch has reached: its own, or the last of its object's own events it ran
+    /// ([`Ctx::reach`]).
+    pub fn reached(&self) -> &VTime<M::Time> {
+        self.reached.as_ref().unwrap_or(&self.now)
     }
 
     /// A context for a batch that may run on an inconsistent state (Time Warp): a send into
@@ -478,7 +520,7 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
     /// Sends `msg` to `to` with zero delay, never to be cancelled: it arrives after this batch,
     /// within the same key.
     pub fn send_now(&mut self, to: u32, msg: M::Msg) {
-        let time = self.now.next_gen();
+        let time = self.reached().next_gen();
         self.relay_at(to, time, msg);
     }
 
@@ -491,10 +533,12 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
             uid: 0,
             t: time.t(),
         };
-        if time <= self.now {
+        if time <= *self.reached() {
             let what = format!(
                 "object {} sent a message into the past: {:?} at {:?}",
-                self.me, time, self.now
+                self.me,
+                time,
+                self.reached()
             );
             assert!(self.speculative, "{what}");
             self.into_past.get_or_insert(what);
@@ -548,6 +592,21 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
 
     /// Reports output (a physical event, a drawing).
     pub fn emit(&mut self, out: M::Output) {
+        if !self.output_times.is_empty() {
+            self.output_times.push(self.now.clone());
+        }
+        self.output.push(out);
+    }
+
+    /// Reports output of one of the object's own events the batch ran on to, at `time`
+    /// ([`Ctx::may_run`]): executors that hold outputs back order them by these times.
+    pub fn emit_at(&mut self, time: VTime<M::Time>, out: M::Output) {
+        if time != self.now || !self.output_times.is_empty() {
+            // the outputs before the first at another time were at the batch's
+            self.output_times
+                .resize(self.output.len(), self.now.clone());
+            self.output_times.push(time);
+        }
         self.output.push(out);
     }
 }

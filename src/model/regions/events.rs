@@ -8,7 +8,7 @@
 //! and follows it from cell to cell, but leaves everything else it meets to its owner, who
 //! sends its new course.
 
-use super::region::{Partner, Region, NOWHERE};
+use super::region::{Partner, Region, Undo, NOWHERE};
 use super::{News, RegionEvent};
 use crate::engine::{Event, EventKind, Fixed};
 use crate::geometry::{Trajectory, Vec2};
@@ -148,26 +148,25 @@ impl Region {
     }
 
     /// Runs every queued event at `key` (the batch of the region's wake-up at `key`), then
-    /// the events after it while `more` allows each one's key and none has had news for a
+    /// the events after it while `more` allows each one's key (it is shown the region's
+    /// journal, where the event's old values will start) and none has had news for a
     /// neighbour. What they report and tell the neighbours goes to the region's reports and
-    /// outbox. The key of the last event run after `key`, if any.
-    pub(super) fn run_on(&mut self, key: &Key, mut more: impl FnMut(&Key) -> bool) -> Option<Key> {
-        let mut reached = None;
+    /// outbox.
+    pub(super) fn run_on(&mut self, key: &Key, mut more: impl FnMut(&Key, &mut Vec<Undo>) -> bool) {
         let mut run = 0;
         while let Some(i) = self.first() {
             let k = self.cold[i as usize].queued.clone();
             if k > *key {
-                if !self.outbox.is_empty() || run >= SPAN || !more(&k) {
+                if !self.outbox.is_empty() || run >= SPAN || !more(&k, &mut self.journal) {
                     break;
                 }
-                reached = Some(k.clone());
+                self.next_stretch();
             }
             run += 1;
             debug_assert!(k >= *key, "a region's event {k:?} was left behind {key:?}");
             self.now = k.t;
             self.run_one(i, &k);
         }
-        reached
     }
 
     /// Runs record `i`'s queued event, at `k`.
@@ -229,7 +228,8 @@ impl Region {
                 b: sb.gid,
             };
             let across = sa.owner != sb.owner;
-            self.reports.push(RegionEvent { event, across });
+            self.reports
+                .push((key.clone(), RegionEvent { event, across }));
         }
         self.turn(a, key, va);
         self.turn(b, key, vb);
@@ -249,10 +249,13 @@ impl Region {
             a: s.gid,
             b: f,
         };
-        self.reports.push(RegionEvent {
-            event,
-            across: false,
-        });
+        self.reports.push((
+            key.clone(),
+            RegionEvent {
+                event,
+                across: false,
+            },
+        ));
         let column = self.grid.column(s.cell);
         match table.bounce(f, s.traj.at(key.t), s.traj.velocity) {
             Some(v) => {

@@ -375,18 +375,40 @@ impl Model for Regions {
             state.set_wake(None);
             // on an executor that allows it, the region's own events up to the next message
             // run in this batch too (a few thousand at most), until one of them has news for
-            // a neighbour
-            let reached = state.run_on(&now.key, |k| ctx.may_run(&VTime::at(k.clone())));
-            if let Some(k) = reached {
-                ctx.reach(VTime::at(k));
-            }
-            for ev in state.reports.drain(..) {
-                ctx.emit(ev);
+            // a neighbour; the executor marks where each one's old values start in the
+            // journal, to undo the batch back to any of them
+            state.run_on(&now.key, |k, journal| {
+                let t = VTime::at(k.clone());
+                if !ctx.may_run(&t) {
+                    return false;
+                }
+                if let Some(j) = ctx.journal() {
+                    std::mem::swap(j, journal);
+                }
+                ctx.reach(t);
+                if let Some(j) = ctx.journal() {
+                    std::mem::swap(j, journal);
+                }
+                true
+            });
+            for (key, ev) in state.reports.drain(..) {
+                ctx.emit_at(VTime::at(key), ev);
             }
             for (to, news) in state.outbox.drain(..) {
                 ctx.send_now(to, RegionMsg::News(news));
             }
         }
+        self.schedule(ctx, state);
+        state.end(ctx.journal());
+    }
+
+    fn runs_ahead(&self, _obj: u32) -> bool {
+        true
+    }
+
+    fn cut(&self, ctx: &mut Ctx<'_, Self>, _me: u32, state: &mut Region) {
+        // the events kept sent nothing: only the wake-up for the next one is missing
+        state.begin(ctx.journal());
         self.schedule(ctx, state);
         state.end(ctx.journal());
     }

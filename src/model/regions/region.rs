@@ -169,13 +169,17 @@ pub struct Region {
     /// Whether the batch being run keeps the old values of what it changes.
     journaling: bool,
     /// Old values kept in the batch being run, oldest first.
-    journal: Vec<Undo>,
-    /// Records whose old values the batch being run has kept.
+    pub(super) journal: Vec<Undo>,
+    /// The stretch of the batch being run in which each record's old value was kept last
+    /// (by index; 0: never).
     kept: Vec<u32>,
+    /// The stretch of the batch being run: a batch's start, or one of its own events it runs
+    /// on to ([`Region::next_stretch`]).
+    stretch: u32,
     /// News for the neighbours from the batch being run, in order.
     pub(super) outbox: Vec<(u32, News)>,
-    /// Events the batch being run reports.
-    pub(super) reports: Vec<RegionEvent>,
+    /// Events the batch being run reports, each at its key.
+    pub(super) reports: Vec<(Key, RegionEvent)>,
 }
 
 impl Region {
@@ -195,6 +199,7 @@ impl Region {
             journaling: false,
             journal: Vec::new(),
             kept: Vec::new(),
+            stretch: 0,
             outbox: Vec::new(),
             reports: Vec::new(),
         }
@@ -234,7 +239,7 @@ impl Region {
     /// Starts a batch that keeps the old values of what it changes in `journal` (the
     /// executor's, swapped in until [`Region::end`]), or keeps none.
     pub(super) fn begin(&mut self, journal: Option<&mut Vec<Undo>>) {
-        self.kept.clear();
+        self.next_stretch();
         self.journaling = journal.is_some();
         if let Some(j) = journal {
             std::mem::swap(&mut self.journal, j);
@@ -258,12 +263,28 @@ impl Region {
         }
     }
 
-    /// Keeps record `i` as it is, once per batch, before the batch changes it.
+    /// Starts a stretch of the batch: records are kept anew from here, so that the executor
+    /// can undo the batch back to this point alone.
+    pub(super) fn next_stretch(&mut self) {
+        self.stretch = self.stretch.wrapping_add(1).max(1);
+        if self.stretch == 1 {
+            self.kept.fill(0);
+        }
+    }
+
+    /// Keeps record `i` as it is, once per stretch of a batch, before the batch changes it.
     #[inline]
     pub(super) fn keep(&mut self, i: u32) {
-        if self.journaling && !self.kept.contains(&i) {
-            self.kept.push(i);
-            let (s, c) = (self.slots[i as usize], self.cold[i as usize].clone());
+        if !self.journaling {
+            return;
+        }
+        let k = i as usize;
+        if k >= self.kept.len() {
+            self.kept.resize(k + 1, 0);
+        }
+        if self.kept[k] != self.stretch {
+            self.kept[k] = self.stretch;
+            let (s, c) = (self.slots[k], self.cold[k].clone());
             self.journal.push(Undo::Ball(i, s, c));
         }
     }

@@ -137,6 +137,13 @@ pub struct TwStats {
     pub rollbacks: u64,
     /// Of them, rollbacks a worker made itself to free memory.
     pub artificial_rollbacks: u64,
+    /// Batches cut back to one of their own events they ran on to ([`Ctx::may_run`](crate::Ctx::may_run)),
+    /// for a message that came inside their span, instead of being undone whole.
+    pub cuts: u64,
+    /// An object's own events that batches ran on to, undone ones included.
+    pub ran_on: u64,
+    /// Of them, events undone by a cut or a rollback.
+    pub ran_on_undone: u64,
     /// Messages sent to an object on another worker.
     pub remote_messages: u64,
     /// Messages sent in all (local and remote, rolled-back sends included).
@@ -178,6 +185,9 @@ impl TwStats {
         self.rolled_back += o.rolled_back;
         self.rollbacks += o.rollbacks;
         self.artificial_rollbacks += o.artificial_rollbacks;
+        self.cuts += o.cuts;
+        self.ran_on += o.ran_on;
+        self.ran_on_undone += o.ran_on_undone;
         self.remote_messages += o.remote_messages;
         self.messages += o.messages;
         self.anti_messages += o.anti_messages;

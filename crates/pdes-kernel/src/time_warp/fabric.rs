@@ -138,6 +138,9 @@ pub struct Committed<T, S, O> {
     pub state: Option<S>,
     /// What it reported.
     pub output: Vec<O>,
+    /// The time of each output, for a batch that ran its object's own events on past its
+    /// time ([`Ctx::may_run`](crate::Ctx::may_run)); empty when all are at its time.
+    pub times: Vec<VTime<T>>,
 }
 
 /// A committed batch of model `M`.
@@ -166,6 +169,10 @@ pub struct Chunk<T, S, O> {
     pub error: Option<String>,
     /// Where the worker stood after this round.
     pub progress: Progress,
+    /// Below every output the worker may still commit: GVT, or the start of an uncommitted
+    /// batch that ran on past it. The collector holds back later outputs until every
+    /// worker's floor has passed them.
+    pub open: Floor,
 }
 
 /// One worker's counts after a GVT round, from the start of the run: what

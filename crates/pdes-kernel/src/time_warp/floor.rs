@@ -19,7 +19,7 @@ use std::cmp::Ordering;
 pub const DEPTH: usize = TIE_WORDS;
 
 /// A lower bound on the (virtual time, receiver) of every batch that may still change.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Floor {
     /// Simulation time.
     pub t: f64,
@@ -136,6 +136,15 @@ impl Floor {
     /// The smaller of two floors.
     pub fn min(self, o: Floor) -> Floor {
         if o < self {
+            o
+        } else {
+            self
+        }
+    }
+
+    /// The larger of two floors.
+    pub fn max(self, o: Floor) -> Floor {
+        if o > self {
             o
         } else {
             self

@@ -98,6 +98,11 @@ impl<T> Log<T> {
         (chain.last != NONE).then(|| self.entry(chain.last).item.as_ref().expect("live"))
     }
 
+    /// The latest record of `chain`, to change.
+    pub fn last_mut(&mut self, chain: &Chain) -> Option<&mut T> {
+        (chain.last != NONE).then(|| self.entry_mut(chain.last).item.as_mut().expect("live"))
+    }
+
     /// The oldest record of `chain`.
     pub fn first(&self, chain: &Chain) -> Option<&T> {
         (chain.first != NONE).then(|| self.entry(chain.first).item.as_ref().expect("live"))

@@ -60,6 +60,7 @@ pub mod mpi;
 pub mod thread_fabric;
 pub mod threads;
 
+mod collector;
 mod config;
 mod fabric;
 mod floor;
@@ -69,6 +70,7 @@ mod marks;
 mod window;
 mod worker;
 
+pub use collector::Collector;
 pub use config::{
     RoundRecord, TwConfig, TwStats, ACROSS_RANKS_GVT_INTERVAL, DEFAULT_BURST, MAX_CASCADE_DEPTH,
     PURE_BURST, THREADS_GVT_INTERVAL,

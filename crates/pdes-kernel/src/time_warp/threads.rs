@@ -2,15 +2,12 @@
 //! under MPI) while the calling thread collects committed batches and feeds them, in order, to
 //! the sink.
 
+use super::collector::{ChunkOf, Collector};
 use super::thread_fabric::ThreadFabric;
-use super::{
-    Chunk, CommittedOf, Fabric, Halt, ObjectMap, Op, Placement, RoundRecord, TwConfig, TwStats,
-    Worker,
-};
+use super::{Fabric, Halt, ObjectMap, Op, Placement, RoundRecord, TwConfig, TwStats, Worker};
 use crate::executor::ExecError;
 use crate::sequential::Sink;
 use crate::{Interrupt, MessageStats, Model, VTime};
-use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{mpsc, Arc};
 
@@ -28,134 +25,6 @@ impl Drop for WorkerEnd<'_> {
     fn drop(&mut self) {
         self.count.fetch_add(1, Ordering::Release);
         self.collector.unpark();
-    }
-}
-
-/// A model's chunk of committed batches.
-type ChunkOf<M> = Chunk<<M as Model>::Time, <M as Model>::State, <M as Model>::Output>;
-
-/// Committed batches of one round from every worker, merged and fed to the sink.
-pub struct Collector<M: Model> {
-    states: Vec<M::State>,
-    /// Whether workers ship observed states with their batches; when not, the sink is shown no
-    /// states during the run (an empty slice), only the final ones after it.
-    shipped: bool,
-    rounds: BTreeMap<u64, Vec<ChunkOf<M>>>,
-    next_round: u64,
-    /// Workers' final states, held until every round before them has gone to the sink: a
-    /// worker's last chunk can arrive before another worker's chunk of their last round.
-    finals: Vec<(u32, M::State)>,
-    /// Workers whose last chunk of this run has arrived.
-    lasts: usize,
-    /// Statistics of the workers' last chunks.
-    pub stats: TwStats,
-    /// Committed message statistics (summed over runs).
-    pub messages: MessageStats,
-    /// Live messages left at the end.
-    pub pending: u64,
-    /// The records of the rounds so far, when it keeps them ([`TwConfig::record_rounds`]).
-    pub records: Option<Vec<RoundRecord>>,
-}
-
-impl<M: Model> Collector<M> {
-    /// A collector starting from the objects' initial states.
-    pub fn new(states: Vec<M::State>) -> Collector<M> {
-        Collector {
-            states,
-            shipped: true,
-            rounds: BTreeMap::new(),
-            next_round: 1,
-            finals: Vec::new(),
-            lasts: 0,
-            stats: TwStats::default(),
-            messages: MessageStats::default(),
-            pending: 0,
-            records: None,
-        }
-    }
-
-    /// Takes one chunk and runs every round it completes through `sink`; the first failure
-    /// (the sink's error, or a worker's) goes to `failed`, and output stops there.
-    pub fn take<E>(
-        &mut self,
-        model: &M,
-        workers: usize,
-        chunk: Chunk<M::Time, M::State, M::Output>,
-        sink: &mut Sink<'_, M, E>,
-        failed: &mut Option<ExecError<E>>,
-    ) {
-        if let Some((stats, messages, pending)) = &chunk.last {
-            self.stats.add(stats);
-            self.messages.add(messages);
-            self.pending += pending;
-            self.finals.extend(chunk.finals);
-            self.lasts += 1;
-            if let (Some(e), None) = (&chunk.error, &failed) {
-                *failed = Some(ExecError::Failed(e.clone()));
-            }
-            self.settle(workers);
-            return;
-        }
-        self.rounds.entry(chunk.round).or_default().push(chunk);
-        while self
-            .rounds
-            .get(&self.next_round)
-            .is_some_and(|v| v.len() == workers)
-        {
-            let chunks = self.rounds.remove(&self.next_round).expect("a round");
-            if let Some(records) = &mut self.records {
-                records.push(RoundRecord::of(self.next_round, &chunks));
-            }
-            self.next_round += 1;
-            if failed.is_some() {
-                continue;
-            }
-            let mut batches: Vec<Option<CommittedOf<M>>> = chunks
-                .into_iter()
-                .flat_map(|c| c.batches)
-                .map(Some)
-                .collect();
-            // (time, object) names one batch: sort a permutation, not the records
-            let mut order: Vec<usize> = (0..batches.len()).collect();
-            order.sort_unstable_by(|&i, &j| {
-                let (a, b) = (batches[i].as_ref(), batches[j].as_ref());
-                let (a, b) = (a.expect("unmoved"), b.expect("unmoved"));
-                a.time.cmp(&b.time).then(a.obj.cmp(&b.obj))
-            });
-            for c in order
-                .into_iter()
-                .map(|i| batches[i].take().expect("taken once"))
-            {
-                if let Some(state) = c.state {
-                    self.states[c.obj as usize] = state;
-                }
-                for o in c.output {
-                    let states: &[M::State] = if self.shipped { &self.states } else { &[] };
-                    if let Err(e) = sink(model, states, o) {
-                        *failed = Some(ExecError::Sink(e));
-                        break;
-                    }
-                }
-                if failed.is_some() {
-                    break;
-                }
-            }
-        }
-        self.settle(workers);
-    }
-
-    /// Takes the final states once every worker has sent them and every round is through.
-    fn settle(&mut self, workers: usize) {
-        if self.lasts == workers && self.rounds.is_empty() {
-            for (id, state) in self.finals.drain(..) {
-                self.states[id as usize] = state;
-            }
-        }
-    }
-
-    /// The committed states.
-    pub fn states(&self) -> &[M::State] {
-        &self.states
     }
 }
 
@@ -347,15 +216,12 @@ where
     pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, ExecError<E>> {
         if std::mem::take(&mut self.handed_over) {
             for w in &mut self.workers {
-                w.restore_states(&self.collector.states);
+                w.restore_states(self.collector.states());
             }
         }
         let (tx, rx) = mpsc::channel();
         let mut failed: Option<ExecError<E>> = None;
-        self.collector.stats = TwStats::default();
-        self.collector.pending = 0;
-        self.collector.lasts = 0;
-        self.collector.finals.clear();
+        self.collector.begin_run();
         if self.ranks == 1 {
             let fabric = ThreadFabric::<M>::new(self.workers.len(), tx);
             self.drive(&fabric, &rx, until, sink, &mut failed);
@@ -383,7 +249,7 @@ where
         // the workers of the collecting process hand their final states over in place
         if failed.is_none() && collects_results() {
             for w in &mut self.workers {
-                w.swap_states(&mut self.collector.states);
+                w.swap_states(self.collector.states_mut());
             }
             self.handed_over = true;
         }
@@ -464,7 +330,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::super::thread_fabric::{ThreadReduce, NOTHING};
-    use super::super::{Bounds, Floor, Reduction};
+    use super::super::{Bounds, Chunk, Floor, Reduction};
     use super::*;
     use crate::time_warp::Committed;
     use crate::PlainTime;
@@ -506,6 +372,7 @@ mod tests {
             finals: Vec::new(),
             error: None,
             progress: Default::default(),
+            open: Floor::INFINITY,
         }
     }
 
@@ -706,6 +573,7 @@ mod tests {
             obj,
             state: Some(state),
             output,
+            times: Vec::new(),
         };
         // worker 0 commits object 0's batch in round 1 and finishes (object 0 ends at 9) before
         // worker 1's chunk of round 1, whose batch of object 1 reports an output, arrives

@@ -13,12 +13,13 @@ use super::window::AutoWindow;
 use crate::prefetch::{prefetch, prefetch_all};
 use crate::queue::{Queue, Ranked};
 use crate::{
-    uid, Ctx, Envelope, Handle, Interrupt, MessageStats, Model, Pending, Saving, Time, VTime,
-    RESERVED_PER_OBJECT, STATE_CLASSES,
+    uid, Ctx, Envelope, Handle, Horizon, Interrupt, MessageStats, Model, Pending, Saving, Time,
+    VTime, RESERVED_PER_OBJECT, STATE_CLASSES,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::cmp::Ordering;
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
 
 /// A message waiting in a worker's heap, with its transport name.
 struct Item<T, Msg> {
@@ -199,6 +200,8 @@ enum Saved<M: Model> {
 /// A batch an object ran that is not committed yet.
 struct Done<M: Model> {
     time: VTime<M::Time>,
+    /// The time it reached: its own, or the last of its object's own events it ran on to.
+    end: VTime<M::Time>,
     /// What restores the object's state before it.
     saved: Saved<M>,
     pre_seq: u64,
@@ -210,6 +213,10 @@ struct Done<M: Model> {
     cancels: Vec<Handle>,
     cancel_calls: u32,
     output: Vec<M::Output>,
+    output_times: Vec<VTime<M::Time>>,
+    /// Where each of its object's own events it ran on to starts in its journal
+    /// ([`Ctx::marks`]).
+    marks: Vec<(VTime<M::Time>, usize)>,
     /// A send into the past it tried: harmless if rolled back, a model bug if committed.
     into_past: Option<String>,
 }
@@ -218,6 +225,8 @@ struct Done<M: Model> {
 /// [`Worker::log_batch`] when it ran speculatively.
 struct Did<'a, M: Model> {
     time: VTime<M::Time>,
+    /// The time it reached ([`Done::end`]).
+    end: VTime<M::Time>,
     /// The object's count of named messages before it.
     uids: u64,
     /// The object's send sequence before it.
@@ -226,6 +235,8 @@ struct Did<'a, M: Model> {
     delivered: usize,
     cancelled: &'a [Handle],
     output: Vec<M::Output>,
+    output_times: Vec<VTime<M::Time>>,
+    marks: Vec<(VTime<M::Time>, usize)>,
     into_past: Option<String>,
 }
 
@@ -255,6 +266,13 @@ struct Lp<M: Model> {
     history: Chain,
     /// Whether it is in its worker's list of objects with uncommitted batches.
     active: bool,
+    /// For an object that runs ahead ([`Model::runs_ahead`]): the times of the messages
+    /// pushed for it, earliest first, those of its batches run and of cancelled messages
+    /// included until its batches pass them (they can only end its spans sooner).
+    waiting: Option<BinaryHeap<Reverse<VTime<M::Time>>>>,
+    /// Whether its latest batch was cut back ([`Worker::cut`]) and waits to be ended anew
+    /// ([`Model::cut`]).
+    cut: bool,
 }
 
 /// Where each object lives: its worker and its index there.
@@ -377,6 +395,10 @@ pub struct Worker<M: Model> {
     high: Option<VTime<M::Time>>,
     /// Below every op in the outboxes.
     outbox_floor: Floor,
+    /// Whether some object here runs ahead ([`Model::runs_ahead`]).
+    runs_ahead: bool,
+    /// Local objects whose latest batch was cut back, to be ended anew before anything else.
+    cuts: Vec<u32>,
     /// What the collector needs of committed batches, until the chunk of the first GVT round
     /// that passes them: the collector puts out a round's batches after the round before's,
     /// and a batch run as final may be later than one another worker commits a round after.
@@ -422,6 +444,8 @@ impl<M: Model> Worker<M> {
                     uids: 0,
                     history: Chain::EMPTY,
                     active: false,
+                    waiting: None,
+                    cut: false,
                 })
                 .collect(),
             placement,
@@ -468,6 +492,8 @@ impl<M: Model> Worker<M> {
             cancel_floor: Floor::NEG_INFINITY,
             high: None,
             outbox_floor: Floor::INFINITY,
+            runs_ahead: false,
+            cuts: Vec::new(),
             to_ship: Vec::new(),
         }
     }
@@ -475,6 +501,12 @@ impl<M: Model> Worker<M> {
     /// Runs every object's `init` at `start`; its sends are routed like any others (flush
     /// them with [`Worker::take_outbox`]). Init sends are committed at once.
     pub fn init(&mut self, model: &M, start: &VTime<M::Time>) {
+        for lp in &mut self.lps {
+            if model.runs_ahead(lp.id) {
+                lp.waiting = Some(BinaryHeap::new());
+                self.runs_ahead = true;
+            }
+        }
         for k in 0..self.lps.len() {
             let lp = &mut self.lps[k];
             let (id, first) = (lp.id, lp.uids);
@@ -588,7 +620,7 @@ impl<M: Model> Worker<M> {
                     return;
                 }
                 if self.ran_past(li, &p.time) {
-                    self.rollback(li, &p.time); // a straggler
+                    self.straggler(li, &p.time);
                 }
                 self.push(Item { uid, p });
             }
@@ -636,58 +668,255 @@ impl<M: Model> Worker<M> {
     #[inline(always)]
     fn push(&mut self, it: Item<M::Time, M::Msg>) {
         let in_instant = it.p.time.key == self.current;
+        self.note_waiting(it.p.to, &it.p.time);
         self.heap.push(it, in_instant);
     }
 
-    /// Undoes every batch of local object `li` at `time` or later.
+    /// Notes a message for object `to` at `time` among those waiting for it, if it runs ahead.
+    #[inline(always)]
+    fn note_waiting(&mut self, to: u32, time: &VTime<M::Time>) {
+        if self.runs_ahead {
+            let li = self.placement.local(to);
+            if let Some(w) = &mut self.lps[li].waiting {
+                w.push(Reverse(time.clone()));
+            }
+        }
+    }
+
+    /// How far a batch of local object `li` at `time` may run its object's own events on
+    /// ([`Ctx::may_run`]): before the next message waiting for it, and not past `limit`; a
+    /// batch run as final, moreover, only before every message waiting here and every op
+    /// another worker may still send. None for an object that does not run ahead, or when the
+    /// collector reads states.
+    fn horizon(
+        &mut self,
+        li: usize,
+        time: &VTime<M::Time>,
+        limit: f64,
+        run_final: bool,
+    ) -> Option<Horizon<M::Time>> {
+        if self.ship {
+            return None;
+        }
+        let waiting = self.lps[li].waiting.as_mut()?;
+        while waiting.peek().is_some_and(|Reverse(t)| t <= time) {
+            waiting.pop();
+        }
+        let mut before = waiting.peek().map(|Reverse(t)| t.clone());
+        let mut until = limit;
+        if run_final {
+            if let Some(top) = self.heap.peek() {
+                if before.as_ref().is_none_or(|b| top.p.time < *b) {
+                    before = Some(top.p.time.clone());
+                }
+            }
+            until = until.min(self.final_bound.t.next_down());
+        }
+        Some(Horizon { before, until })
+    }
+
+    /// Undoes every batch of local object `li` that reached `time` or later.
     fn rollback(&mut self, li: usize, time: &VTime<M::Time>) {
         self.stats.rollbacks += 1;
-        while self.last_time(li).is_some_and(|t| t >= time) {
-            let lp = &mut self.lps[li];
-            let d = self.log.pop_last(&mut lp.history).expect("a batch to undo");
-            self.uncommitted -= 1;
-            self.stats.rolled_back += 1;
-            match d.saved {
-                Saved::Copy(class, pre_state) => {
-                    let undone = std::mem::replace(&mut lp.state, pre_state);
-                    self.give_state(class, undone);
-                }
-                Saved::Journal(mut journal, restore) => {
-                    while let Some(undo) = journal.pop() {
-                        restore(&mut lp.state, undo);
-                    }
-                    give(&mut self.spare.journals, journal);
-                }
+        while self.last_reached(li).is_some_and(|t| t >= time) {
+            self.undo_last(li);
+        }
+    }
+
+    /// Rolls local object `li` back for a message that came for it at `time`, after it ran
+    /// past it: a batch that ran its object's own events on across `time` is cut back to the
+    /// last of them before it ([`Worker::cut`]), every later batch undone.
+    fn straggler(&mut self, li: usize, time: &VTime<M::Time>) {
+        self.stats.rollbacks += 1;
+        while self
+            .log
+            .last(&self.lps[li].history)
+            .is_some_and(|d| d.time >= *time)
+        {
+            self.undo_last(li);
+        }
+        let Some(d) = self.log.last(&self.lps[li].history) else {
+            return;
+        };
+        if d.end < *time {
+            return;
+        }
+        if d.marks.is_empty() || !matches!(d.saved, Saved::Journal(..)) {
+            self.undo_last(li);
+        } else {
+            self.cut(li, time);
+        }
+    }
+
+    /// Undoes local object `li`'s latest uncommitted batch: restores the state before it,
+    /// puts its messages back, and annuls what it sent and cancelled.
+    fn undo_last(&mut self, li: usize) {
+        let lp = &mut self.lps[li];
+        let d = self.log.pop_last(&mut lp.history).expect("a batch to undo");
+        lp.cut = false;
+        self.uncommitted -= 1;
+        self.stats.rolled_back += 1;
+        self.stats.ran_on_undone += d.marks.len() as u64;
+        match d.saved {
+            Saved::Copy(class, pre_state) => {
+                let undone = std::mem::replace(&mut lp.state, pre_state);
+                self.give_state(class, undone);
             }
-            let lp = &mut self.lps[li];
-            lp.seq = d.pre_seq;
-            let to = lp.id;
-            let (mut inputs, mut batch, mut sent) = (d.inputs, d.batch, d.sent);
-            for (i, env) in inputs.drain(..).zip(batch.drain(..)) {
-                self.heap.push(i.into_item(env, &d.time, to), false);
+            Saved::Journal(mut journal, restore) => {
+                while let Some(undo) = journal.pop() {
+                    restore(&mut lp.state, undo);
+                }
+                give(&mut self.spare.journals, journal);
             }
-            for (s, _) in sent.drain(..) {
-                let op = Op::Anti {
-                    uid: s.uid,
-                    to: s.to,
-                    time: s.time,
+        }
+        let lp = &mut self.lps[li];
+        lp.seq = d.pre_seq;
+        let to = lp.id;
+        let (mut inputs, mut batch) = (d.inputs, d.batch);
+        for (i, env) in inputs.drain(..).zip(batch.drain(..)) {
+            self.note_waiting(to, &d.time);
+            self.heap.push(i.into_item(env, &d.time, to), false);
+        }
+        give(&mut self.spare.inputs, inputs);
+        give(&mut self.spare.batches, batch);
+        let (mut sent, mut cancels) = (d.sent, d.cancels);
+        self.annul(to, &d.end, &mut sent, &mut cancels);
+        give(&mut self.spare.sent, sent);
+        give(&mut self.spare.cancels, cancels);
+    }
+
+    /// Annuls what a batch of object `by` that reached `end` sent (anti-messages) and
+    /// cancelled (cancellations withdrawn), emptying both.
+    fn annul(
+        &mut self,
+        by: u32,
+        end: &VTime<M::Time>,
+        sent: &mut Vec<(Sent<M::Time>, u16)>,
+        cancels: &mut Vec<Handle>,
+    ) {
+        for (s, _) in sent.drain(..) {
+            let op = Op::Anti {
+                uid: s.uid,
+                to: s.to,
+                time: s.time,
+            };
+            self.route(op);
+        }
+        for h in cancels.drain(..) {
+            let op = Op::Cancel {
+                h,
+                at: end.clone(),
+                by,
+                sign: -1,
+            };
+            self.route(op);
+        }
+    }
+
+    /// Cuts local object `li`'s latest batch, which ran its own events on across `time`, back
+    /// to before the first of them at or after `time`: restores the journal from that
+    /// event's mark on, drops those events' outputs and annuls what the batch sent and
+    /// cancelled at its end. The batch stays, ending at the last event it keeps; the model
+    /// ends it anew ([`Worker::resume_cuts`]) before anything else runs.
+    fn cut(&mut self, li: usize, time: &VTime<M::Time>) {
+        self.stats.cuts += 1;
+        let lp = &mut self.lps[li];
+        let d = self.log.last_mut(&lp.history).expect("a batch to cut");
+        let m = d.marks.partition_point(|(t, _)| t < time);
+        let Saved::Journal(journal, restore) = &mut d.saved else {
+            unreachable!("only a journaled batch is cut");
+        };
+        let from = d.marks[m].1;
+        while journal.len() > from {
+            restore(&mut lp.state, journal.pop().expect("a record"));
+        }
+        self.stats.ran_on_undone += (d.marks.len() - m) as u64;
+        let end = std::mem::replace(
+            &mut d.end,
+            match m {
+                0 => d.time.clone(),
+                _ => d.marks[m - 1].0.clone(),
+            },
+        );
+        d.marks.truncate(m);
+        if !d.output_times.is_empty() {
+            let kept = d.output_times.partition_point(|t| t < time);
+            d.output.truncate(kept);
+            d.output_times.truncate(kept);
+        }
+        lp.seq = d.pre_seq;
+        d.cancel_calls = 0;
+        d.into_past = None;
+        let (mut sent, mut cancels) = (std::mem::take(&mut d.sent), std::mem::take(&mut d.cancels));
+        if !lp.cut {
+            lp.cut = true;
+            self.cuts.push(li as u32);
+        }
+        let by = lp.id;
+        self.annul(by, &end, &mut sent, &mut cancels);
+        let d = self
+            .log
+            .last_mut(&self.lps[li].history)
+            .expect("the batch cut");
+        (d.sent, d.cancels) = (sent, cancels);
+    }
+
+    /// Ends anew, by the model ([`Model::cut`]), every batch cut back since the last call,
+    /// and sends what it sends then.
+    fn resume_cuts(&mut self, model: &M) {
+        while !self.cuts.is_empty() {
+            self.resume_cuts_once(model);
+            self.drain_local();
+        }
+    }
+
+    /// Ends anew the batches cut back so far ([`Worker::resume_cuts`]).
+    fn resume_cuts_once(&mut self, model: &M) {
+        while let Some(li) = self.cuts.pop() {
+            let li = li as usize;
+            let lp = &mut self.lps[li];
+            if !std::mem::take(&mut lp.cut) {
+                continue; // undone whole since
+            }
+            let d = self.log.last_mut(&lp.history).expect("the batch cut");
+            let Saved::Journal(journal, _) = &mut d.saved else {
+                unreachable!("only a journaled batch is cut");
+            };
+            let (id, first) = (lp.id, lp.uids);
+            let mut ctx = Ctx::speculative(model, d.end.clone(), id, &mut lp.seq)
+                .named(&mut lp.uids)
+                .journaled(journal);
+            ctx.sent = std::mem::take(&mut self.spare.pending);
+            model.cut(&mut ctx, id, &mut lp.state);
+            assert!(ctx.output.is_empty(), "a cut batch's end emits nothing");
+            let (mut sent, cancelled) = (ctx.sent, ctx.cancelled);
+            d.into_past = ctx.into_past;
+            d.cancel_calls = cancelled.len() as u32;
+            let end = d.end.clone();
+            for (n, p) in (first + 1..).zip(sent.iter()) {
+                let s = Sent {
+                    uid: uid(id, n),
+                    to: p.to,
+                    time: p.time.clone(),
                 };
-                self.route(op);
+                d.sent.push((s, model.kind(&p.env.msg) as u16));
             }
-            give(&mut self.spare.inputs, inputs);
-            give(&mut self.spare.batches, batch);
-            give(&mut self.spare.sent, sent);
-            let mut cancels = d.cancels;
-            for h in cancels.drain(..) {
+            d.cancels
+                .extend(cancelled.iter().filter(|h| still_to_come(h, &end)));
+            let cancels = d.cancels.clone();
+            for h in cancels {
                 let op = Op::Cancel {
                     h,
-                    at: d.time.clone(),
-                    by: to,
-                    sign: -1,
+                    at: end.clone(),
+                    by: id,
+                    sign: 1,
                 };
                 self.route(op);
             }
-            give(&mut self.spare.cancels, cancels);
+            for (n, p) in (first + 1..).zip(sent.drain(..)) {
+                self.send(uid(id, n), p);
+            }
+            self.spare.pending = sent;
         }
     }
 
@@ -773,6 +1002,18 @@ impl<M: Model> Worker<M> {
             self.bound_wait -= 1;
             return None;
         }
+        self.refresh_bounds(fabric);
+        let by = self.final_by_bounds(time, to, cancellable);
+        if by.is_none() {
+            // each try reads every worker's slot of this process twice
+            self.bound_wait = self.workers_here - 1;
+        }
+        by
+    }
+
+    /// Reads the bounds below what other workers may still send here afresh
+    /// ([`Fabric::peers_floor`]), where the fabric tells them.
+    fn refresh_bounds<F: Fabric<M>>(&mut self, fabric: &F) {
         if let Some(peers) = fabric.peers_floor(self.index, self.lookahead) {
             let mut own = self.outbox_floor;
             if let Some(c) = &self.chaos {
@@ -783,18 +1024,26 @@ impl<M: Model> Worker<M> {
             self.final_bound = peers.any.min(own);
             self.message_bound = peers.messages.min(own);
         }
-        let by = self.final_by_bounds(time, to, cancellable);
-        if by.is_none() {
-            // each try reads every worker's slot of this process twice
-            self.bound_wait = self.workers_here - 1;
+    }
+
+    /// Where the optimism window starts: GVT, or, for objects that run ahead where batches
+    /// run as final, the bound below what other workers may still send here, read afresh (it
+    /// moves on between GVT rounds, and their spans with it).
+    fn window_base<F: Fabric<M>>(&mut self, fabric: &F) -> f64 {
+        if !(self.final_ok && self.runs_ahead) {
+            return self.gvt.t;
         }
-        by
+        self.refresh_bounds(fabric);
+        self.gvt.t.max(self.final_bound.t)
     }
 
     /// Runs the next batch if its time is at most `limit` (and, when `final_only`, if it may
     /// run as final); false when there is none.
     #[inline(always)]
     fn step<F: Fabric<M>>(&mut self, model: &M, fabric: &F, limit: f64, final_only: bool) -> bool {
+        if !self.cuts.is_empty() {
+            self.resume_cuts(model);
+        }
         match self.next_time() {
             Some(t) if t <= limit => {}
             _ => return false,
@@ -803,7 +1052,6 @@ impl<M: Model> Worker<M> {
             return false;
         }
         let (time, mut taken) = self.take_batch();
-        self.latest = self.latest.max(time.t());
         let run_final = self.settle_final(model, fabric, &time, &mut taken);
         // the next batch's object, most likely (a local one: its message is here): where it
         // lives now, and its record once the handler has run (not at once: the record's place
@@ -817,25 +1065,38 @@ impl<M: Model> Worker<M> {
         }
         self.check_depth(&time, taken.to, run_final);
         let (to, li, next) = (taken.to, taken.li, taken.next);
+        let horizon = self
+            .runs_ahead
+            .then(|| self.horizon(li, &time, limit, run_final))
+            .flatten();
         let lp = &mut self.lps[li];
         let (pre_seq, first) = (lp.seq, lp.uids);
         let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq).named(&mut lp.uids);
         if let Some(Saved::Journal(journal, _)) = &mut taken.saved {
             ctx = ctx.journaled(journal);
         }
+        if let Some(h) = horizon {
+            ctx = ctx.with_horizon(h);
+        }
         ctx.sent = std::mem::take(&mut self.spare.pending);
         model.handle(&mut ctx, to, &mut lp.state, &taken.batch);
         let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
-        let into_past = ctx.into_past;
+        let (into_past, output_times, marks) = (ctx.into_past, ctx.output_times, ctx.marks);
+        self.stats.ran_on += marks.len() as u64;
+        let end = ctx.reached.unwrap_or_else(|| time.clone());
+        self.latest = self.latest.max(end.t());
         self.stats.processed += 1;
         let mut ops = std::mem::take(&mut self.spare.ops);
         let did = Did {
             time,
+            end,
             uids: first,
             pre_seq,
             delivered: taken.batch.len(),
             cancelled: &cancelled,
             output,
+            output_times,
+            marks,
             into_past,
         };
         if run_final {
@@ -877,7 +1138,7 @@ impl<M: Model> Worker<M> {
         }
         let li = self.placement.local(to);
         debug_assert!(
-            self.last_time(li).is_none_or(|t| *t < time),
+            self.last_reached(li).is_none_or(|t| *t < time),
             "batches run in order"
         );
         let mut inputs = take(&mut self.spare.inputs);
@@ -979,7 +1240,7 @@ impl<M: Model> Worker<M> {
         sent: &mut Vec<Pending<M::Time, M::Msg>>,
         ops: &mut Vec<Op<M::Time, M::Msg>>,
     ) {
-        let (to, li, time) = (taken.to, taken.li, did.time);
+        let (to, li, time, end) = (taken.to, taken.li, did.time, did.end);
         let mut sent_recs = take(&mut self.spare.sent);
         for (n, p) in (did.uids + 1..).zip(sent.iter()) {
             let s = Sent {
@@ -994,11 +1255,11 @@ impl<M: Model> Worker<M> {
         } else {
             take(&mut self.spare.cancels)
         };
-        cancels.extend(did.cancelled.iter().filter(|h| still_to_come(h, &time)));
+        cancels.extend(did.cancelled.iter().filter(|h| still_to_come(h, &end)));
         for &h in &cancels {
             ops.push(Op::Cancel {
                 h,
-                at: time.clone(),
+                at: end.clone(),
                 by: to,
                 sign: 1,
             });
@@ -1008,11 +1269,12 @@ impl<M: Model> Worker<M> {
             lp.active = true;
             self.active.push(li as u32);
         }
-        if self.high.as_ref().is_none_or(|h| *h < time) {
-            self.high = Some(time.clone());
+        if self.high.as_ref().is_none_or(|h| *h < end) {
+            self.high = Some(end.clone());
         }
         let done = Done {
             time,
+            end,
             saved: taken.saved.expect("saved: the batch is not final"),
             pre_seq: did.pre_seq,
             inputs: taken.inputs,
@@ -1021,6 +1283,8 @@ impl<M: Model> Worker<M> {
             cancels,
             cancel_calls: did.cancelled.len() as u32,
             output: did.output,
+            output_times: did.output_times,
+            marks: did.marks,
             into_past: did.into_past,
         };
         self.log.push(&mut lp.history, li as u32, done);
@@ -1061,7 +1325,7 @@ impl<M: Model> Worker<M> {
             }
         }
         let state = (self.ship && model.observed(id)).then(|| self.lps[li].state.clone());
-        self.keep_for_collector(did.time, id, state, did.output);
+        self.keep_for_collector(did.time, id, state, did.output, did.output_times);
     }
 
     /// Sends a message a batch (or `init`) of this worker has just made. On this worker it goes
@@ -1079,7 +1343,7 @@ impl<M: Model> Worker<M> {
         debug_assert!(!self.final_floor.reaches(&p.time, p.to), "sends go forward");
         let li = self.placement.local(p.to);
         if self.ran_past(li, &p.time) {
-            self.rollback(li, &p.time);
+            self.straggler(li, &p.time);
         }
         self.push(Item { uid, p });
         self.note_entries();
@@ -1101,16 +1365,16 @@ impl<M: Model> Worker<M> {
         self.log.slots()
     }
 
-    /// The time of local object `li`'s latest uncommitted batch.
-    fn last_time(&self, li: usize) -> Option<&VTime<M::Time>> {
-        self.log.last(&self.lps[li].history).map(|d| &d.time)
+    /// The time local object `li`'s latest uncommitted batch reached ([`Done::end`]).
+    fn last_reached(&self, li: usize) -> Option<&VTime<M::Time>> {
+        self.log.last(&self.lps[li].history).map(|d| &d.end)
     }
 
     /// Whether local object `li` ran a batch at `time` or later that is not committed yet.
     fn ran_past(&self, li: usize, time: &VTime<M::Time>) -> bool {
         // no batch ran past the latest one run: most messages are later than it
         self.high.as_ref().is_some_and(|h| h >= time)
-            && self.last_time(li).is_some_and(|t| t >= time)
+            && self.last_reached(li).is_some_and(|t| t >= time)
     }
 
     /// Notes how many messages this worker holds, for the summary's peak.
@@ -1134,7 +1398,7 @@ impl<M: Model> Worker<M> {
         let after = t.next_gen();
         for li in 0..self.lps.len() {
             let from = if self.lps[li].id < first { &after } else { &t };
-            if self.last_time(li).is_some_and(|x| x >= from) {
+            if self.last_reached(li).is_some_and(|x| x >= from) {
                 self.stats.artificial_rollbacks += 1;
                 self.rollback(li, from);
             }
@@ -1181,7 +1445,9 @@ impl<M: Model> Worker<M> {
 
     /// Sends the outboxes' ops, then publishes this worker's floor (the ops' inboxes cover
     /// them from there).
-    fn flush<F: Fabric<M>>(&mut self, fabric: &F) {
+    fn flush<F: Fabric<M>>(&mut self, model: &M, fabric: &F) {
+        // a batch cut back sends again before this worker's floor is read
+        self.resume_cuts(model);
         for (w, ops) in self.take_outbox(0..self.outbox.len()) {
             self.sent_ops += ops.len() as i64;
             fabric.send(self.index, w, ops);
@@ -1226,6 +1492,7 @@ impl<M: Model> Worker<M> {
     /// before it is final).
     fn gvt_round<F: Fabric<M>>(
         &mut self,
+        model: &M,
         fabric: &F,
         stop: bool,
         interrupt: usize,
@@ -1233,7 +1500,7 @@ impl<M: Model> Worker<M> {
         let mut buf = Vec::new();
         loop {
             self.receive(fabric, &mut buf);
-            self.flush(fabric);
+            self.flush(model, fabric);
             let local = Reduction {
                 in_flight: self.sent_ops - self.received_ops,
                 floor: self.local_min(),
@@ -1272,7 +1539,7 @@ impl<M: Model> Worker<M> {
         give(&mut self.spare.batches, d.batch);
         give(&mut self.spare.cancels, d.cancels);
         self.give_saved(d.saved);
-        self.keep_for_collector(d.time, self.lps[li].id, state, d.output);
+        self.keep_for_collector(d.time, self.lps[li].id, state, d.output, d.output_times);
     }
 
     /// Counts a committed batch that handled `delivered` messages and made `cancels`
@@ -1298,6 +1565,7 @@ impl<M: Model> Worker<M> {
         obj: u32,
         state: Option<M::State>,
         output: Vec<M::Output>,
+        times: Vec<VTime<M::Time>>,
     ) {
         if state.is_some() || !output.is_empty() {
             self.to_ship.push(Committed {
@@ -1305,6 +1573,7 @@ impl<M: Model> Worker<M> {
                 obj,
                 state,
                 output,
+                times,
             });
         }
     }
@@ -1322,7 +1591,7 @@ impl<M: Model> Worker<M> {
             if !self
                 .log
                 .first(&lp.history)
-                .is_some_and(|d| floor.passed(&d.time, lp.id))
+                .is_some_and(|d| floor.passed(&d.end, lp.id))
             {
                 break;
             }
@@ -1371,7 +1640,7 @@ impl<M: Model> Worker<M> {
         // the log's front is the oldest batch of its object
         while let Some((li, d)) = self.log.front() {
             let li = li as usize;
-            if !bound.passed(&d.time, self.lps[li].id) {
+            if !bound.passed(&d.end, self.lps[li].id) {
                 break;
             }
             self.commit_front(model, li, &bound);
@@ -1441,13 +1710,13 @@ impl<M: Model> Worker<M> {
         let mut since = 0u32;
         self.lookahead = model.lookahead();
         self.started = Some(std::time::Instant::now());
-        let (interval, ahead) = self.prepare(fabric, cfg, ship);
+        let (interval, ahead) = self.prepare(model, fabric, cfg, ship);
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
-            let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window.width);
+            let window = self.window_base(fabric) + cfg.window.unwrap_or(self.auto_window.width);
             let (ran, held_back) = self.burst(model, fabric, cfg, until.min(window), ahead);
-            self.flush(fabric);
+            self.flush(model, fabric);
             self.commit_early(model);
             since += ran.max(1);
             if ran == 0 && !held_back {
@@ -1473,7 +1742,7 @@ impl<M: Model> Worker<M> {
             since = 0;
             let asked = halt.failed.load(std::sync::atomic::Ordering::Relaxed);
             let cause = halt.interrupt.and_then(Interrupt::cause).unwrap_or(0);
-            match self.gvt_round(fabric, asked || over || self.fault.is_some(), cause) {
+            match self.gvt_round(model, fabric, asked || over || self.fault.is_some(), cause) {
                 Err(s) => break Err(self.why_stopped(s, over, cfg)),
                 Ok(g) => {
                     // every worker ends at the same time: nobody has run a batch after it
@@ -1498,7 +1767,13 @@ impl<M: Model> Worker<M> {
 
     /// Sets the worker up for a run on `fabric`: the GVT interval in batches, and the number
     /// of uncommitted batches past which it runs only final ones.
-    fn prepare<F: Fabric<M>>(&mut self, fabric: &F, cfg: &TwConfig, ship: bool) -> (u32, usize) {
+    fn prepare<F: Fabric<M>>(
+        &mut self,
+        model: &M,
+        fabric: &F,
+        cfg: &TwConfig,
+        ship: bool,
+    ) -> (u32, usize) {
         let ranks = threads::place().1;
         let interval = cfg.interval(ranks);
         // across ranks at least as many as at the threads' default interval, though rounds come
@@ -1522,7 +1797,7 @@ impl<M: Model> Worker<M> {
         // this run's fabric knows nothing of this worker yet: its first flush publishes
         self.published = Floor::NEG_INFINITY;
         self.final_ok = cfg.final_batches && fabric.shares_floors();
-        self.flush(fabric);
+        self.flush(model, fabric);
         (interval, ahead)
     }
 
@@ -1583,6 +1858,10 @@ impl<M: Model> Worker<M> {
     /// A GVT round reached `gvt`: the window adapts, batches before it are committed and
     /// handed to the collector (after a sweep of cancelled messages when `sweep`).
     fn advance_gvt<F: Fabric<M>>(&mut self, model: &M, fabric: &F, gvt: Floor, sweep: bool) {
+        // a batch that ran on past GVT and was rolled back waits below it again; its rerun
+        // sends nothing before the message that rolled it back, which GVT did not pass
+        // ([`Ctx::may_run`]), so GVT stays where it was
+        let gvt = gvt.max(self.gvt);
         let moved = if self.gvt.t.is_finite() && gvt.t.is_finite() {
             gvt.t - self.gvt.t
         } else {
@@ -1593,6 +1872,7 @@ impl<M: Model> Worker<M> {
         self.gvt = gvt;
         let batches = self.fossil_collect(model, gvt, sweep);
         self.round += 1;
+        let open = self.open_floor();
         fabric.commit(Chunk {
             worker: self.index,
             round: self.round,
@@ -1601,7 +1881,24 @@ impl<M: Model> Worker<M> {
             finals: Vec::new(),
             error: None,
             progress: self.progress(),
+            open,
         });
+    }
+
+    /// Below every output this worker may still commit ([`Chunk::open`]): GVT, the start of
+    /// its objects' oldest uncommitted batches (one may have run on past GVT), and its next
+    /// message (a batch rolled back may wait below GVT to run again).
+    fn open_floor(&mut self) -> Floor {
+        let mut open = self.gvt.min(self.local_min());
+        if self.runs_ahead {
+            for &li in &self.active {
+                let lp = &self.lps[li as usize];
+                if let Some(d) = self.log.first(&lp.history) {
+                    open = open.min(Floor::of(&d.time, lp.id));
+                }
+            }
+        }
+        open
     }
 
     /// The worker's counts so far, for the collector's records of rounds.
@@ -1650,6 +1947,7 @@ impl<M: Model> Worker<M> {
             finals,
             error,
             progress: self.progress(),
+            open: Floor::INFINITY,
         });
     }
 }
