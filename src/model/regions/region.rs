@@ -218,6 +218,18 @@ impl Region {
             .count()
     }
 
+    /// About how many news a second come to the region: each ghost turns or crosses a cell
+    /// about once per cell width it travels, so its speed over a cell's width, summed.
+    pub fn news_rate(&self) -> f64 {
+        let me = self.shape.me;
+        let width = self.grid.cell_size().x;
+        (self.local.values())
+            .map(|&i| &self.slots[i as usize])
+            .filter(|s| s.owner != me && s.cell != NOWHERE)
+            .map(|s| s.traj.velocity.norm() / width)
+            .sum()
+    }
+
     /// Ball `gid`'s state as last fixed, if this region owns it.
     pub fn ball(&self, gid: u32) -> Option<BallState> {
         let i = *self.local.get(&gid)? as usize;

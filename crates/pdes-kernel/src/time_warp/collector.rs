@@ -56,8 +56,9 @@ impl<M: Model> Ord for Held<M> {
 
 /// What a [`Held`] carries.
 enum Item<M: Model> {
-    /// The object's state after a batch.
-    State(M::State),
+    /// The object's state after a batch (boxed: a state may be far larger than an output,
+    /// and the heap moves its items).
+    State(Box<M::State>),
     /// An output.
     Output(M::Output),
 }
@@ -158,7 +159,7 @@ impl<M: Model> Collector<M> {
     fn hold(&mut self, c: Committed<M::Time, M::State, M::Output>) {
         let (time, obj) = (c.time, c.obj);
         if let Some(state) = c.state {
-            let (what, seq, time) = (Item::State(state), self.seq, time.clone());
+            let (what, seq, time) = (Item::State(Box::new(state)), self.seq, time.clone());
             self.seq += 1;
             self.held.push(Held {
                 time,
@@ -199,7 +200,7 @@ impl<M: Model> Collector<M> {
                 continue;
             }
             match h.what {
-                Item::State(state) => self.states[h.obj as usize] = state,
+                Item::State(state) => self.states[h.obj as usize] = *state,
                 Item::Output(o) => {
                     let states: &[M::State] = if self.shipped { &self.states } else { &[] };
                     if let Err(e) = sink(model, states, o) {

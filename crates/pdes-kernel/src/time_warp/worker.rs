@@ -1026,17 +1026,6 @@ impl<M: Model> Worker<M> {
         }
     }
 
-    /// Where the optimism window starts: GVT, or, for objects that run ahead where batches
-    /// run as final, the bound below what other workers may still send here, read afresh (it
-    /// moves on between GVT rounds, and their spans with it).
-    fn window_base<F: Fabric<M>>(&mut self, fabric: &F) -> f64 {
-        if !(self.final_ok && self.runs_ahead) {
-            return self.gvt.t;
-        }
-        self.refresh_bounds(fabric);
-        self.gvt.t.max(self.final_bound.t)
-    }
-
     /// Runs the next batch if its time is at most `limit` (and, when `final_only`, if it may
     /// run as final); false when there is none.
     #[inline(always)]
@@ -1714,7 +1703,7 @@ impl<M: Model> Worker<M> {
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
-            let window = self.window_base(fabric) + cfg.window.unwrap_or(self.auto_window.width);
+            let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window.width);
             let (ran, held_back) = self.burst(model, fabric, cfg, until.min(window), ahead);
             self.flush(model, fabric);
             self.commit_early(model);
