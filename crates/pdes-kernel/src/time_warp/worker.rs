@@ -197,11 +197,23 @@ enum Saved<M: Model> {
     Journal(Vec<M::Undo>, fn(&mut M::State, M::Undo)),
 }
 
+/// What a batch that ran its object's own events on ([`Ctx::may_run`]) adds to its record:
+/// boxed, so that a batch that did not pays nothing for it.
+struct Span<T> {
+    /// The last of its object's own events it ran.
+    end: VTime<T>,
+    /// The time of each output ([`Ctx::output_times`]; empty when all are at its time).
+    output_times: Vec<VTime<T>>,
+    /// Where each of its object's own events it ran on to starts in its journal
+    /// ([`Ctx::marks`]).
+    marks: Vec<(VTime<T>, usize)>,
+}
+
 /// A batch an object ran that is not committed yet.
 struct Done<M: Model> {
     time: VTime<M::Time>,
-    /// The time it reached: its own, or the last of its object's own events it ran on to.
-    end: VTime<M::Time>,
+    /// What it ran past its time, if anything.
+    span: Option<Box<Span<M::Time>>>,
     /// What restores the object's state before it.
     saved: Saved<M>,
     pre_seq: u64,
@@ -213,20 +225,28 @@ struct Done<M: Model> {
     cancels: Vec<Handle>,
     cancel_calls: u32,
     output: Vec<M::Output>,
-    output_times: Vec<VTime<M::Time>>,
-    /// Where each of its object's own events it ran on to starts in its journal
-    /// ([`Ctx::marks`]).
-    marks: Vec<(VTime<M::Time>, usize)>,
     /// A send into the past it tried: harmless if rolled back, a model bug if committed.
     into_past: Option<String>,
+}
+
+impl<M: Model> Done<M> {
+    /// The time it reached: its own, or the last of its object's own events it ran on to.
+    fn end(&self) -> &VTime<M::Time> {
+        self.span.as_ref().map_or(&self.time, |s| &s.end)
+    }
+}
+
+/// The outputs' times of a batch that ran on (none for one that did not: all at its time).
+fn output_times<T>(span: Option<Box<Span<T>>>) -> Vec<VTime<T>> {
+    span.map(|s| s.output_times).unwrap_or_default()
 }
 
 /// What a batch did: for [`Worker::commit_final`] when it ran as final, for
 /// [`Worker::log_batch`] when it ran speculatively.
 struct Did<'a, M: Model> {
     time: VTime<M::Time>,
-    /// The time it reached ([`Done::end`]).
-    end: VTime<M::Time>,
+    /// What it ran past its time ([`Done::span`]).
+    span: Option<Box<Span<M::Time>>>,
     /// The object's count of named messages before it.
     uids: u64,
     /// The object's send sequence before it.
@@ -235,8 +255,6 @@ struct Did<'a, M: Model> {
     delivered: usize,
     cancelled: &'a [Handle],
     output: Vec<M::Output>,
-    output_times: Vec<VTime<M::Time>>,
-    marks: Vec<(VTime<M::Time>, usize)>,
     into_past: Option<String>,
 }
 
@@ -738,10 +756,11 @@ impl<M: Model> Worker<M> {
         let Some(d) = self.log.last(&self.lps[li].history) else {
             return;
         };
-        if d.end < *time {
+        if *d.end() < *time {
             return;
         }
-        if d.marks.is_empty() || !matches!(d.saved, Saved::Journal(..)) {
+        let marked = d.span.as_ref().is_some_and(|s| !s.marks.is_empty());
+        if !marked || !matches!(d.saved, Saved::Journal(..)) {
             self.undo_last(li);
         } else {
             self.cut(li, time);
@@ -756,7 +775,8 @@ impl<M: Model> Worker<M> {
         lp.cut = false;
         self.uncommitted -= 1;
         self.stats.rolled_back += 1;
-        self.stats.ran_on_undone += d.marks.len() as u64;
+        let end = d.end().clone();
+        self.stats.ran_on_undone += d.span.as_ref().map_or(0, |s| s.marks.len()) as u64;
         match d.saved {
             Saved::Copy(class, pre_state) => {
                 let undone = std::mem::replace(&mut lp.state, pre_state);
@@ -780,7 +800,7 @@ impl<M: Model> Worker<M> {
         give(&mut self.spare.inputs, inputs);
         give(&mut self.spare.batches, batch);
         let (mut sent, mut cancels) = (d.sent, d.cancels);
-        self.annul(to, &d.end, &mut sent, &mut cancels);
+        self.annul(to, &end, &mut sent, &mut cancels);
         give(&mut self.spare.sent, sent);
         give(&mut self.spare.cancels, cancels);
     }
@@ -822,27 +842,28 @@ impl<M: Model> Worker<M> {
         self.stats.cuts += 1;
         let lp = &mut self.lps[li];
         let d = self.log.last_mut(&lp.history).expect("a batch to cut");
-        let m = d.marks.partition_point(|(t, _)| t < time);
+        let span = d.span.as_mut().expect("only a batch that ran on is cut");
+        let m = span.marks.partition_point(|(t, _)| t < time);
         let Saved::Journal(journal, restore) = &mut d.saved else {
             unreachable!("only a journaled batch is cut");
         };
-        let from = d.marks[m].1;
+        let from = span.marks[m].1;
         while journal.len() > from {
             restore(&mut lp.state, journal.pop().expect("a record"));
         }
-        self.stats.ran_on_undone += (d.marks.len() - m) as u64;
+        self.stats.ran_on_undone += (span.marks.len() - m) as u64;
         let end = std::mem::replace(
-            &mut d.end,
+            &mut span.end,
             match m {
                 0 => d.time.clone(),
-                _ => d.marks[m - 1].0.clone(),
+                _ => span.marks[m - 1].0.clone(),
             },
         );
-        d.marks.truncate(m);
-        if !d.output_times.is_empty() {
-            let kept = d.output_times.partition_point(|t| t < time);
+        span.marks.truncate(m);
+        if !span.output_times.is_empty() {
+            let kept = span.output_times.partition_point(|t| t < time);
             d.output.truncate(kept);
-            d.output_times.truncate(kept);
+            span.output_times.truncate(kept);
         }
         lp.seq = d.pre_seq;
         d.cancel_calls = 0;
@@ -879,11 +900,12 @@ impl<M: Model> Worker<M> {
                 continue; // undone whole since
             }
             let d = self.log.last_mut(&lp.history).expect("the batch cut");
+            let end = d.end().clone();
             let Saved::Journal(journal, _) = &mut d.saved else {
                 unreachable!("only a journaled batch is cut");
             };
             let (id, first) = (lp.id, lp.uids);
-            let mut ctx = Ctx::speculative(model, d.end.clone(), id, &mut lp.seq)
+            let mut ctx = Ctx::speculative(model, end.clone(), id, &mut lp.seq)
                 .named(&mut lp.uids)
                 .journaled(journal);
             ctx.sent = std::mem::take(&mut self.spare.pending);
@@ -892,7 +914,6 @@ impl<M: Model> Worker<M> {
             let (mut sent, cancelled) = (ctx.sent, ctx.cancelled);
             d.into_past = ctx.into_past;
             d.cancel_calls = cancelled.len() as u32;
-            let end = d.end.clone();
             for (n, p) in (first + 1..).zip(sent.iter()) {
                 let s = Sent {
                     uid: uid(id, n),
@@ -1070,22 +1091,30 @@ impl<M: Model> Worker<M> {
         ctx.sent = std::mem::take(&mut self.spare.pending);
         model.handle(&mut ctx, to, &mut lp.state, &taken.batch);
         let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
-        let (into_past, output_times, marks) = (ctx.into_past, ctx.output_times, ctx.marks);
-        self.stats.ran_on += marks.len() as u64;
-        let end = ctx.reached.unwrap_or_else(|| time.clone());
-        self.latest = self.latest.max(end.t());
+        let into_past = ctx.into_past;
+        let span = (ctx.reached.is_some() || !ctx.output_times.is_empty()).then(|| {
+            Box::new(Span {
+                end: ctx.reached.unwrap_or_else(|| time.clone()),
+                output_times: ctx.output_times,
+                marks: ctx.marks,
+            })
+        });
+        if let Some(s) = &span {
+            self.stats.ran_on += s.marks.len() as u64;
+            self.latest = self.latest.max(s.end.t());
+        } else {
+            self.latest = self.latest.max(time.t());
+        }
         self.stats.processed += 1;
         let mut ops = std::mem::take(&mut self.spare.ops);
         let did = Did {
             time,
-            end,
+            span,
             uids: first,
             pre_seq,
             delivered: taken.batch.len(),
             cancelled: &cancelled,
             output,
-            output_times,
-            marks,
             into_past,
         };
         if run_final {
@@ -1229,7 +1258,8 @@ impl<M: Model> Worker<M> {
         sent: &mut Vec<Pending<M::Time, M::Msg>>,
         ops: &mut Vec<Op<M::Time, M::Msg>>,
     ) {
-        let (to, li, time, end) = (taken.to, taken.li, did.time, did.end);
+        let end = did.span.as_ref().map_or(&did.time, |s| &s.end).clone();
+        let (to, li, time) = (taken.to, taken.li, did.time);
         let mut sent_recs = take(&mut self.spare.sent);
         for (n, p) in (did.uids + 1..).zip(sent.iter()) {
             let s = Sent {
@@ -1263,7 +1293,7 @@ impl<M: Model> Worker<M> {
         }
         let done = Done {
             time,
-            end,
+            span: did.span,
             saved: taken.saved.expect("saved: the batch is not final"),
             pre_seq: did.pre_seq,
             inputs: taken.inputs,
@@ -1272,8 +1302,6 @@ impl<M: Model> Worker<M> {
             cancels,
             cancel_calls: did.cancelled.len() as u32,
             output: did.output,
-            output_times: did.output_times,
-            marks: did.marks,
             into_past: did.into_past,
         };
         self.log.push(&mut lp.history, li as u32, done);
@@ -1314,7 +1342,8 @@ impl<M: Model> Worker<M> {
             }
         }
         let state = (self.ship && model.observed(id)).then(|| self.lps[li].state.clone());
-        self.keep_for_collector(did.time, id, state, did.output, did.output_times);
+        let times = output_times(did.span);
+        self.keep_for_collector(did.time, id, state, did.output, times);
     }
 
     /// Sends a message a batch (or `init`) of this worker has just made. On this worker it goes
@@ -1356,7 +1385,7 @@ impl<M: Model> Worker<M> {
 
     /// The time local object `li`'s latest uncommitted batch reached ([`Done::end`]).
     fn last_reached(&self, li: usize) -> Option<&VTime<M::Time>> {
-        self.log.last(&self.lps[li].history).map(|d| &d.end)
+        self.log.last(&self.lps[li].history).map(|d| d.end())
     }
 
     /// Whether local object `li` ran a batch at `time` or later that is not committed yet.
@@ -1528,7 +1557,8 @@ impl<M: Model> Worker<M> {
         give(&mut self.spare.batches, d.batch);
         give(&mut self.spare.cancels, d.cancels);
         self.give_saved(d.saved);
-        self.keep_for_collector(d.time, self.lps[li].id, state, d.output, d.output_times);
+        let times = output_times(d.span);
+        self.keep_for_collector(d.time, self.lps[li].id, state, d.output, times);
     }
 
     /// Counts a committed batch that handled `delivered` messages and made `cancels`
@@ -1580,7 +1610,7 @@ impl<M: Model> Worker<M> {
             if !self
                 .log
                 .first(&lp.history)
-                .is_some_and(|d| floor.passed(&d.end, lp.id))
+                .is_some_and(|d| floor.passed(d.end(), lp.id))
             {
                 break;
             }
@@ -1629,7 +1659,7 @@ impl<M: Model> Worker<M> {
         // the log's front is the oldest batch of its object
         while let Some((li, d)) = self.log.front() {
             let li = li as usize;
-            if !bound.passed(&d.end, self.lps[li].id) {
+            if !bound.passed(d.end(), self.lps[li].id) {
                 break;
             }
             self.commit_front(model, li, &bound);
