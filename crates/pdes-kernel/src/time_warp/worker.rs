@@ -236,6 +236,24 @@ impl<M: Model> Done<M> {
     }
 }
 
+/// What a batch of object `by` keeps of the messages it `sent`, for anti-messages and
+/// statistics: the first is named after the object's count `first` of named messages.
+fn sent_records<'a, M: Model>(
+    model: &'a M,
+    by: u32,
+    first: u64,
+    sent: &'a [Pending<M::Time, M::Msg>],
+) -> impl Iterator<Item = (Sent<M::Time>, u16)> + 'a {
+    (first + 1..).zip(sent).map(move |(n, p)| {
+        let s = Sent {
+            uid: uid(by, n),
+            to: p.to,
+            time: p.time.clone(),
+        };
+        (s, model.kind(&p.env.msg) as u16)
+    })
+}
+
 /// The outputs' times of a batch that ran on (none for one that did not: all at its time).
 fn output_times<T>(span: Option<Box<Span<T>>>) -> Vec<VTime<T>> {
     span.map(|s| s.output_times).unwrap_or_default()
@@ -914,14 +932,7 @@ impl<M: Model> Worker<M> {
             let (mut sent, cancelled) = (ctx.sent, ctx.cancelled);
             d.into_past = ctx.into_past;
             d.cancel_calls = cancelled.len() as u32;
-            for (n, p) in (first + 1..).zip(sent.iter()) {
-                let s = Sent {
-                    uid: uid(id, n),
-                    to: p.to,
-                    time: p.time.clone(),
-                };
-                d.sent.push((s, model.kind(&p.env.msg) as u16));
-            }
+            d.sent.extend(sent_records(model, id, first, &sent));
             d.cancels
                 .extend(cancelled.iter().filter(|h| still_to_come(h, &end)));
             let cancels = d.cancels.clone();
@@ -1261,14 +1272,7 @@ impl<M: Model> Worker<M> {
         let end = did.span.as_ref().map_or(&did.time, |s| &s.end).clone();
         let (to, li, time) = (taken.to, taken.li, did.time);
         let mut sent_recs = take(&mut self.spare.sent);
-        for (n, p) in (did.uids + 1..).zip(sent.iter()) {
-            let s = Sent {
-                uid: uid(to, n),
-                to: p.to,
-                time: p.time.clone(),
-            };
-            sent_recs.push((s, model.kind(&p.env.msg) as u16));
-        }
+        sent_recs.extend(sent_records(model, to, did.uids, sent));
         let mut cancels = if did.cancelled.is_empty() {
             Vec::new()
         } else {
