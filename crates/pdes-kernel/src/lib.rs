@@ -36,6 +36,7 @@ pub mod phold;
 pub mod prefetch;
 pub mod queue;
 pub mod sequential;
+mod spin_barrier;
 pub mod time;
 pub mod time_warp;
 

@@ -229,6 +229,9 @@ pub trait Fabric<M: Model>: Sync {
     fn recv(&self, me: usize, into: &mut Vec<Op<M::Time, M::Msg>>);
     /// Reduces `local` over every worker; all workers call it the same number of times.
     fn reduce(&self, me: usize, local: Reduction) -> Reduction;
+    /// A worker of this process panicked: the others must not wait for it in a reduction
+    /// (they stop instead, and the panic reaches the caller).
+    fn abandon(&self) {}
     /// Hands a chunk of committed batches to the collector.
     fn commit(&self, chunk: Chunk<M::Time, M::State, M::Output>);
     /// Whether workers publish floors here and [`Fabric::peers_floor`] can answer: without,

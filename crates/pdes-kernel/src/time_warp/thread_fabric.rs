@@ -2,9 +2,10 @@
 //! barrier for the reductions.
 
 use super::{Bounds, Chunk, Fabric, Floor, Op, Reduction};
+use crate::spin_barrier::SpinBarrier;
 use crate::{Model, Time};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{mpsc, Barrier, Mutex};
+use std::sync::{mpsc, Mutex};
 
 /// The identity of [`Reduction::combine`].
 pub const NOTHING: Reduction = Reduction {
@@ -16,9 +17,12 @@ pub const NOTHING: Reduction = Reduction {
     latest: f64::NEG_INFINITY,
 };
 
-/// Reductions among the threads of one process: three rotating slots and a barrier.
+/// Reductions among the threads of one process: three rotating slots and a barrier that
+/// spins. A round comes every few hundred microseconds on a busy run (10^5 disks in 2
+/// regions: 11,000 rounds in 1.9 s), and with a barrier that puts its threads to sleep every
+/// round cost a wake-up through the system's scheduler.
 pub struct ThreadReduce {
-    barrier: Barrier,
+    barrier: SpinBarrier,
     slots: Mutex<[Reduction; 3]>,
     calls: Vec<AtomicU64>,
 }
@@ -27,7 +31,7 @@ impl ThreadReduce {
     /// Reductions among `n` threads, numbered 0 to `n - 1`.
     pub fn new(n: usize) -> ThreadReduce {
         ThreadReduce {
-            barrier: Barrier::new(n),
+            barrier: SpinBarrier::new(n),
             slots: Mutex::new([NOTHING; 3]),
             calls: (0..n).map(|_| AtomicU64::new(0)).collect(),
         }
@@ -42,12 +46,14 @@ impl ThreadReduce {
             let mut s = self.slots.lock().expect("no thread panicked");
             s[k] = s[k].combine(local);
         }
-        let leader = self.barrier.wait().is_leader();
+        if self.barrier.wait().is_err() {
+            // a worker panicked: the others stop, and the panic reaches the caller
+            return Reduction { stop: 1, ..NOTHING };
+        }
         let mut s = self.slots.lock().expect("no thread panicked");
         let r = s[k];
-        if leader {
-            s[(k + 2) % 3] = NOTHING;
-        }
+        // every thread has read slot k - 1 before it arrived here: any one may clear it
+        s[(k + 2) % 3] = NOTHING;
         r
     }
 }
@@ -263,6 +269,10 @@ where
 
     fn reduce(&self, me: usize, local: Reduction) -> Reduction {
         self.reduce.reduce(me, local)
+    }
+
+    fn abandon(&self) {
+        self.reduce.barrier.poison();
     }
 
     fn commit(&self, chunk: Chunk<M::Time, M::State, M::Output>) {

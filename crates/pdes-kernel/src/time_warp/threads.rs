@@ -14,15 +14,20 @@ use std::sync::{mpsc, Arc};
 /// How long the collector sleeps between looks at the chunks the workers sent.
 const COLLECTOR_NAP: std::time::Duration = std::time::Duration::from_millis(10);
 
-/// Counts a worker's thread as ended, and wakes the collector, when the thread ends (by a
-/// panic too).
+/// Counts a worker's thread as ended, and wakes the collector, when the thread ends; by a
+/// panic too, and then the other workers stop waiting for it.
 struct WorkerEnd<'a> {
     count: &'a AtomicUsize,
     collector: &'a std::thread::Thread,
+    /// Tells the fabric that this worker is gone ([`Fabric::abandon`]).
+    abandon: &'a dyn Fn(),
 }
 
 impl Drop for WorkerEnd<'_> {
     fn drop(&mut self) {
+        if std::thread::panicking() {
+            (self.abandon)();
+        }
         self.count.fetch_add(1, Ordering::Release);
         self.collector.unpark();
     }
@@ -293,6 +298,7 @@ where
         // three sets of 10 pairs)
         let (finished, main) = (AtomicUsize::new(0), std::thread::current());
         std::thread::scope(|scope| {
+            let mut handles = Vec::with_capacity(workers.len());
             for w in workers.iter_mut() {
                 let (cfg, ship) = (&*cfg, collector.shipped);
                 let halt = Halt {
@@ -300,13 +306,15 @@ where
                     interrupt: interrupt.as_ref(),
                 };
                 let (finished, main) = (&finished, &main);
-                scope.spawn(move || {
+                handles.push(scope.spawn(move || {
+                    let abandon = || fabric.abandon();
                     let _end = WorkerEnd {
                         count: finished,
                         collector: main,
+                        abandon: &abandon,
                     };
                     w.run(model, fabric, cfg, until, ship, halt)
-                });
+                }));
             }
             loop {
                 // read before the drain: every chunk of a worker counted as ended is in the
@@ -322,6 +330,12 @@ where
                     break;
                 }
                 std::thread::park_timeout(COLLECTOR_NAP);
+            }
+            // a worker's panic reaches the caller as it was raised
+            for h in handles {
+                if let Err(panic) = h.join() {
+                    std::panic::resume_unwind(panic);
+                }
             }
         });
     }
@@ -739,5 +753,48 @@ mod tests {
                 assert_eq!(tw.tw_stats().committed, seq.stats().batches, "{what}");
             }
         }
+    }
+
+    /// Objects that each wake themselves every unit of time; object 3's handler panics at
+    /// time 5, while the other worker goes on.
+    struct Faulty;
+
+    impl Model for Faulty {
+        type Time = PlainTime;
+        type Msg = ();
+        type State = u32;
+        type Output = ();
+        type Undo = ();
+
+        fn kind_names(&self) -> &'static [&'static str] {
+            &["Tick"]
+        }
+        fn kind(&self, _: &()) -> usize {
+            0
+        }
+        fn priority(&self, _: &()) -> u8 {
+            0
+        }
+        fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, _: &mut u32) {
+            ctx.relay_at(me, at(1.0), ());
+        }
+        fn handle(&self, ctx: &mut Ctx<'_, Self>, me: u32, n: &mut u32, _: &[Envelope<()>]) {
+            *n += 1;
+            assert!(me != 3 || *n < 5, "object 3 is broken");
+            ctx.relay_at(me, at(f64::from(*n) + 1.0), ());
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "object 3 is broken")]
+    fn a_panic_on_a_worker_reaches_the_caller_instead_of_stopping_the_others() {
+        let cfg = TwConfig {
+            workers: 2,
+            gvt_interval: Some(1),
+            ..TwConfig::default()
+        };
+        let map = ObjectMap::RoundRobin;
+        let mut tw = TimeWarp::new(Faulty, vec![0; 6], at(0.0), &map, cfg);
+        let _ = tw.run::<()>(1e6, &mut |_, _, _| Ok(()));
     }
 }
