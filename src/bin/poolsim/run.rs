@@ -437,7 +437,10 @@ fn config_of(
 ) -> Result<RunConfig, Failure> {
     let engine = engine_of(a, scenario)?;
     check_memory(a, scenario, &engine)?;
-    if !matches!(engine, EngineKind::EventList | EngineKind::TimeStep { .. }) {
+    if !matches!(
+        engine,
+        EngineKind::EventList | EngineKind::TimeStep { .. } | EngineKind::Regions { .. }
+    ) {
         poolsim::memory::transparent_huge_pages(false);
     }
     check_options_fit(a, &engine)?;

@@ -8,7 +8,7 @@
 //! and follows it from cell to cell, but leaves everything else it meets to its owner, who
 //! sends its new course.
 
-use super::region::{Partner, Region, Undo, NOWHERE};
+use super::region::{Partner, Region, Slot, Undo, NOWHERE};
 use super::{News, RegionEvent};
 use crate::engine::{Event, EventKind, Fixed};
 use crate::geometry::{Trajectory, Vec2};
@@ -29,10 +29,10 @@ const SPAN: usize = 4096;
 type Near = SmallVec<[u32; 48]>;
 
 impl Region {
-    /// The earliest contact of ball `i` with ball `j` offered to `best`.
+    /// The earliest contact of ball `i` (slot `a`) with ball `j` offered to `best`.
     #[inline]
-    fn offer_ball(&self, i: u32, j: u32, best: &mut (Key, Partner)) {
-        let (a, b) = (&self.slots[i as usize], &self.slots[j as usize]);
+    fn offer_ball(&self, i: u32, a: &Slot, j: u32, best: &mut (Key, Partner)) {
+        let b = &self.slots[j as usize];
         let contact = if a.gid < b.gid {
             physics::ball_ball_contact(&a.traj, a.radius, &b.traj, b.radius)
         } else {
@@ -84,9 +84,11 @@ impl Region {
     /// Offers record `i` its contacts with each of `near` (and, for a ball of the region, the
     /// fixed objects near it) on top of `best`, then sets its cell exit and queues it.
     fn settle_best(&mut self, i: u32, near: &[u32], mut best: (Key, Partner)) {
-        if self.slots[i as usize].cell != NOWHERE {
+        // copied once: the pair tests read it for every neighbour
+        let a = self.slots[i as usize];
+        if a.cell != NOWHERE {
             for &j in near {
-                self.offer_ball(i, j, &mut best);
+                self.offer_ball(i, &a, j, &mut best);
             }
             if self.mine(i) {
                 self.offer_fixed(i, &mut best);
@@ -97,29 +99,26 @@ impl Region {
         self.requeue(i);
     }
 
-    /// The balls record `i` must be tested against among those `each` yields: a ball of the
-    /// region meets everything, a ghost only the region's balls. Their slots start loading.
-    fn candidates(&self, i: u32, each: impl FnOnce(&mut dyn FnMut(u32))) -> Near {
-        let mine = self.mine(i);
-        let mut near = Near::new();
-        each(&mut |j| {
-            if j != i && (mine || self.mine(j)) {
-                prefetch(&self.slots[j as usize]);
-                near.push(j);
-            }
-        });
-        near
+    /// Adds ball `j` to `near`, the balls record `i` (of this region if `mine`) must be tested
+    /// against, if it must be: a ball of the region meets everything, a ghost only the
+    /// region's balls. Its slot starts loading.
+    #[inline(always)]
+    fn consider(&self, i: u32, mine: bool, j: u32, near: &mut Near) {
+        if j != i && (mine || self.mine(j)) {
+            prefetch(&self.slots[j as usize]);
+            near.push(j);
+        }
     }
 
     /// Recomputes record `i`'s earliest event and cell exit, and queues it.
     pub(super) fn predict(&mut self, i: u32) {
         self.keep(i);
         let cell = self.slots[i as usize].cell;
-        let near = if cell == NOWHERE {
-            Near::new()
-        } else {
-            self.candidates(i, |f| self.grid.for_each_near(cell, f))
-        };
+        let mut near = Near::new();
+        if cell != NOWHERE {
+            let mine = self.mine(i);
+            (self.grid).for_each_near(cell, |j| self.consider(i, mine, j, &mut near));
+        }
         let none = (Key::at(f64::INFINITY, 0), Partner::Nothing);
         self.settle_best(i, &near, none);
     }
@@ -305,7 +304,8 @@ impl Region {
         if self.mine(i) && self.tell_crossing(i, from, to) {
             return self.predict(i);
         }
-        let near = self.candidates(i, |f| self.grid.for_each_entering(from, to, f));
+        let (mut near, mine) = (Near::new(), self.mine(i));
+        (self.grid).for_each_entering(from, to, |j| self.consider(i, mine, j, &mut near));
         let best = std::mem::replace(
             &mut self.cold[i as usize].phys,
             (Key::at(f64::INFINITY, 0), Partner::Nothing),
