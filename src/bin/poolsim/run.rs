@@ -437,9 +437,11 @@ fn config_of(
 ) -> Result<RunConfig, Failure> {
     let engine = engine_of(a, scenario)?;
     check_memory(a, scenario, &engine)?;
+    // huge pages pay where memory is laid out once (the event list; regions on the sequential
+    // executor), and cost where Time Warp touches fresh memory all run long
     if !matches!(
         engine,
-        EngineKind::EventList | EngineKind::TimeStep { .. } | EngineKind::Regions { .. }
+        EngineKind::EventList | EngineKind::TimeStep { .. } | EngineKind::Regions { tw: None, .. }
     ) {
         poolsim::memory::transparent_huge_pages(false);
     }

@@ -1485,6 +1485,18 @@ impl<M: Model> Worker<M> {
         }
     }
 
+    /// Where the optimism window starts: GVT, or, where the workers publish their floors, the
+    /// least of them read now (nothing any worker holds or may still send comes before it), so
+    /// that the window moves on with the slowest worker between GVT rounds.
+    fn window_base<F: Fabric<M>>(&mut self, fabric: &F) -> f64 {
+        if !self.final_ok {
+            return self.gvt.t;
+        }
+        self.refresh_bounds(fabric);
+        let floor = self.final_bound.min(self.local_min());
+        floor.t.max(self.gvt.t)
+    }
+
     /// The first batch this worker's unhandled messages and held ops may still change.
     fn local_min(&mut self) -> Floor {
         let mut m = match self.next_time() {
@@ -1737,12 +1749,14 @@ impl<M: Model> Worker<M> {
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
-            let window = self.gvt.t + cfg.window.unwrap_or(self.auto_window.width);
+            let window = self.window_base(fabric) + cfg.window.unwrap_or(self.auto_window.width);
             let (ran, held_back) = self.burst(model, fabric, cfg, until.min(window), ahead);
             self.flush(model, fabric);
             self.commit_early(model);
             since += ran.max(1);
-            if ran == 0 && !held_back {
+            // with nothing to run below its window, a worker asks for a round to move the
+            // window on, unless the window moves with the workers' published floors anyway
+            if ran == 0 && !held_back && !self.final_ok {
                 since = interval;
             }
             if ran == 0 && self.chaos.is_none() {
