@@ -52,7 +52,8 @@ pub struct RunArgs {
     /// Strips the regions engine cuts the table into (default: one per worker).
     #[arg(long)]
     pub regions: Option<u32>,
-    /// Time Warp's optimism window: no batch later than GVT plus this (simulation time).
+    /// Time Warp's optimism window: no batch later than this past the least floor any worker
+    /// holds, GVT or later (simulation time).
     #[arg(long = "tw-window", allow_negative_numbers = true)]
     pub tw_window: Option<f64>,
     /// Time Warp's memory budget: uncommitted batches per worker.

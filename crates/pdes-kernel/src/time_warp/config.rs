@@ -25,7 +25,8 @@ pub struct TwConfig {
     /// Batches a worker runs between GVT rounds; `None` for the default of where it runs
     /// ([`TwConfig::interval`]).
     pub gvt_interval: Option<u32>,
-    /// Optimism window: no batch later than GVT plus this (simulation time); `None` adapts it
+    /// Optimism window: no batch later than GVT plus this (simulation time), or the least floor
+    /// the workers publish plus this where they publish floors; `None` adapts it
     /// to the GVT progress of one batch per message waiting on the worker (1,024 to 8,192
     /// batches) at the recent rate, narrowed while many batches roll back.
     pub window: Option<f64>,

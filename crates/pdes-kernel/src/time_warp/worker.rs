@@ -1746,6 +1746,8 @@ impl<M: Model> Worker<M> {
         self.lookahead = model.lookahead();
         self.started = Some(std::time::Instant::now());
         let (interval, ahead) = self.prepare(model, fabric, cfg, ship);
+        // other ranks' floors are known only from the last round
+        let idle_asks = !self.final_ok || threads::place().1 > 1;
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
@@ -1755,8 +1757,8 @@ impl<M: Model> Worker<M> {
             self.commit_early(model);
             since += ran.max(1);
             // with nothing to run below its window, a worker asks for a round to move the
-            // window on, unless the window moves with the workers' published floors anyway
-            if ran == 0 && !held_back && !self.final_ok {
+            // window on, unless the window moves with the floors its peers publish anyway
+            if ran == 0 && !held_back && idle_asks {
                 since = interval;
             }
             if ran == 0 && self.chaos.is_none() {
