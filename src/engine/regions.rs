@@ -60,11 +60,11 @@ impl World for View<'_> {
 
 /// News the busiest region may hear in Time Warp's optimism window when none is set
 /// ([`Region::news_rate`]): a region that runs past its neighbours' next news is cut back
-/// there, and the kernel's own window, counted in batches and events, does not see that. An
-/// eighth of a news: 10^5 disks at area fraction 0.5 in 2 regions on 2 workers ran fastest at
-/// windows of 2-5 x 10^-4 (an eighth gives 4.7 x 10^-4), and 10^6 disks at 10^-4 to
-/// 2 x 10^-4 (it gives 1.5 x 10^-4), where the kernel's window undid half the events run.
-const NEWS_PER_WINDOW: f64 = 0.125;
+/// there, and the kernel's own window, counted in batches and events, does not see that. A
+/// twelfth of a news: 10^5 disks at area fraction 0.5 in 2 regions on 2 workers ran 4 % faster
+/// at 3 x 10^-4 (a twelfth) than at 4.7 x 10^-4 (an eighth), and 10^6 disks fastest at 10^-4
+/// (a twelfth gives 0.97 x 10^-4), where the kernel's window undid half the events run.
+const NEWS_PER_WINDOW: f64 = 1.0 / 12.0;
 
 impl RegionsEngine {
     /// Sets `count` regions up at `start`, on the sequential executor or (with `tw`) under
