@@ -125,7 +125,8 @@ fn batches_that_run_on_to_the_next_message_are_exact() {
     assert_eq!(assert_same_checked(&s, &[engine], false), 1);
     let (_, sum) = traced(&s, engine, false);
     let tw = sum.time_warp.expect("time warp ran").stats;
-    assert!(tw.ran_on > 2 * tw.committed, "{tw:?}");
+    // more events run on than batches committed, however the threads are scheduled
+    assert!(tw.ran_on > tw.committed, "{tw:?}");
     assert!(tw.cuts > 0 && tw.ran_on_undone > 0, "{tw:?}");
     // one region on one worker runs a short run as one batch, a long one in batches of a few
     // thousand events
