@@ -25,6 +25,7 @@
 
 use super::thread_fabric::{Slots, ThreadReduce, NOTHING};
 use super::{Bounds, Chunk, Fabric, Floor, Op, Reduction};
+use crate::spin_barrier::SpinBarrier;
 use crate::{Model, Time};
 use mpi::collective::SystemOperation;
 use mpi::datatype::{Partition, PartitionMut};
@@ -32,7 +33,7 @@ use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
-use std::sync::{mpsc, Barrier, Mutex};
+use std::sync::{mpsc, Mutex};
 
 /// The smallest of every rank's floor, and of every other rank's than this one's: each rank's
 /// words gathered, the minimum taken alike on every rank.
@@ -95,7 +96,7 @@ pub struct MpiFabric<M: Model> {
     far: Mutex<Far>,
     outgoing: Mutex<Vec<Vec<ParcelOf<M>>>>,
     reduce: ThreadReduce,
-    barrier: Barrier,
+    barrier: SpinBarrier,
     result: Mutex<Reduction>,
     collector: Mutex<Option<mpsc::Sender<ChunkOf<M>>>>,
 }
@@ -126,7 +127,7 @@ where
             }),
             outgoing: Mutex::new((0..ranks).map(|_| Vec::new()).collect()),
             reduce: ThreadReduce::new(per_rank),
-            barrier: Barrier::new(per_rank),
+            barrier: SpinBarrier::new(per_rank),
             result: Mutex::new(NOTHING),
             collector: Mutex::new(collector),
         }
@@ -231,6 +232,11 @@ where
         self.slots.recv(k, into);
     }
 
+    fn abandon(&self) {
+        self.reduce.poison();
+        self.barrier.poison();
+    }
+
     fn shares_floors(&self) -> bool {
         true
     }
@@ -287,7 +293,10 @@ where
             world.all_reduce_into(&here.latest, &mut g.latest, SystemOperation::max());
             *self.result.lock().expect("no thread panicked") = g;
         }
-        self.barrier.wait();
+        if self.barrier.wait().is_err() {
+            // a worker of this rank panicked: the others stop, and the panic reaches the caller
+            return Reduction { stop: 1, ..NOTHING };
+        }
         *self.result.lock().expect("no thread panicked")
     }
 

@@ -37,6 +37,12 @@ impl ThreadReduce {
         }
     }
 
+    /// A thread has gone for good (it panicked): every reduction, now and later, returns at
+    /// once with a stop request.
+    pub fn poison(&self) {
+        self.barrier.poison();
+    }
+
     /// Combines `local` with every other thread's value of the same call.
     pub fn reduce(&self, me: usize, local: Reduction) -> Reduction {
         // call k adds into slot k % 3; after its barrier every thread has read slot (k - 1) % 3,
@@ -272,7 +278,7 @@ where
     }
 
     fn abandon(&self) {
-        self.reduce.barrier.poison();
+        self.reduce.poison();
     }
 
     fn commit(&self, chunk: Chunk<M::Time, M::State, M::Output>) {
