@@ -75,3 +75,25 @@ impl Drop for PoisonOnPanic<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panicking_party_releases_the_others() {
+        let barrier = SpinBarrier::new(2);
+        let result = std::thread::scope(|s| {
+            let waiter = s.spawn(|| barrier.wait());
+            let _ = s
+                .spawn(|| {
+                    let _guard = PoisonOnPanic(&barrier);
+                    panic!("a model bug");
+                })
+                .join();
+            waiter.join().unwrap()
+        });
+        assert!(result.is_err());
+        assert!(barrier.wait().is_err(), "poisoned for good");
+    }
+}

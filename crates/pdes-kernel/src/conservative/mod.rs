@@ -26,10 +26,11 @@ mod sync;
 
 use crate::executor::ExecError;
 use crate::sequential::Sink;
+use crate::spin_barrier::{PoisonOnPanic, SpinBarrier};
 use crate::time_warp::ObjectMap;
 use crate::{Interrupt, MessageStats, Model, VTime};
 use part::{Done, Home, Mail, Part, Window};
-use sync::{Boxes, PoisonOnPanic, Reports, Round, SpinBarrier, FAILED, INTERRUPTED};
+use sync::{Boxes, Reports, Round, FAILED, INTERRUPTED};
 
 /// The conservative executor's settings.
 #[derive(Clone, Debug)]

@@ -232,8 +232,13 @@ struct Done<M: Model> {
 impl<M: Model> Done<M> {
     /// The time it reached: its own, or the last of its object's own events it ran on to.
     fn end(&self) -> &VTime<M::Time> {
-        self.span.as_ref().map_or(&self.time, |s| &s.end)
+        reached(&self.time, &self.span)
     }
+}
+
+/// The time a batch at `time` reached: its own, or the end of its `span`.
+fn reached<'a, T>(time: &'a VTime<T>, span: &'a Option<Box<Span<T>>>) -> &'a VTime<T> {
+    span.as_ref().map_or(time, |s| &s.end)
 }
 
 /// What a batch of object `by` keeps of the messages it `sent`, for anti-messages and
@@ -1110,12 +1115,8 @@ impl<M: Model> Worker<M> {
                 marks: ctx.marks,
             })
         });
-        if let Some(s) = &span {
-            self.stats.ran_on += s.marks.len() as u64;
-            self.latest = self.latest.max(s.end.t());
-        } else {
-            self.latest = self.latest.max(time.t());
-        }
+        self.stats.ran_on += span.as_ref().map_or(0, |s| s.marks.len()) as u64;
+        self.latest = self.latest.max(reached(&time, &span).t());
         self.stats.processed += 1;
         let mut ops = std::mem::take(&mut self.spare.ops);
         let did = Did {
@@ -1269,7 +1270,7 @@ impl<M: Model> Worker<M> {
         sent: &mut Vec<Pending<M::Time, M::Msg>>,
         ops: &mut Vec<Op<M::Time, M::Msg>>,
     ) {
-        let end = did.span.as_ref().map_or(&did.time, |s| &s.end).clone();
+        let end = reached(&did.time, &did.span).clone();
         let (to, li, time) = (taken.to, taken.li, did.time);
         let mut sent_recs = take(&mut self.spare.sent);
         sent_recs.extend(sent_records(model, to, did.uids, sent));
