@@ -646,6 +646,12 @@ impl Grid {
         }
     }
 
+    /// The ids of the cells of the 3 × 3 block around cell `c`, `c` first (none if `c` is no
+    /// cell).
+    pub fn cells_near(&self, c: u32) -> impl Iterator<Item = u32> {
+        self.block(c).into_iter().filter(|&k| k != NIL)
+    }
+
     /// The ids of the 3 × 3 block of cells around cell `c`, `c` first (`NIL` where there is no
     /// cell, and all `NIL` if `c` is no cell).
     fn block(&self, c: u32) -> [u32; 9] {

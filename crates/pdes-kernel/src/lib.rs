@@ -220,6 +220,45 @@ pub trait Model {
     fn cut(&self, ctx: &mut Ctx<'_, Self>, me: u32, state: &mut Self::State) {
         let _ = (ctx, me, state);
     }
+    /// Whether `msg`, coming for an object whose latest batch ran its own events on past the
+    /// message's time, may wait for its turn and be offered to [`Model::take_in`] then,
+    /// instead of cutting that batch back at once. Asked of objects saved incrementally
+    /// ([`Saving::Incremental`]) that run ahead ([`Model::runs_ahead`]), under Time Warp.
+    fn may_take_in(msg: &Self::Msg) -> bool
+    where
+        Self: Sized,
+    {
+        let _ = msg;
+        false
+    }
+    /// Takes `batch`, at `ctx.now()`, into object `me` after its latest batches, which ran
+    /// its own events on to `ctx.reached()`, past the batch's time (only batches whose
+    /// messages all [`Model::may_take_in`]). The model answers true when that gives the state
+    /// that handling the batch in its turn and then running those events would have given:
+    /// the batch changes nothing they read or did, and its effects start after
+    /// `ctx.reached()`; it then sends (after `ctx.reached()`) and cancels what that would
+    /// have, and emits nothing. It answers false when it cannot tell: the executor then puts
+    /// back what the call saved in its journal ([`Ctx::journal`]; the call must save every
+    /// change), drops what it sent and cancelled, cuts the object back to before the batch,
+    /// and runs the batch in its turn.
+    ///
+    /// A batch taken in is undone with the batches it followed. If a message later than the
+    /// batch undoes it (and cuts them back), the executor offers it `again`, right after the
+    /// cut: the events it follows are then those it followed before, up to that message, and
+    /// the model must take it in without checking them anew (what they touched since may
+    /// have been undone without a trace), checking only its own effects against the time
+    /// reached.
+    fn take_in(
+        &self,
+        ctx: &mut Ctx<'_, Self>,
+        me: u32,
+        state: &mut Self::State,
+        batch: &[Envelope<Self::Msg>],
+        again: bool,
+    ) -> bool {
+        let _ = (ctx, me, state, batch, again);
+        false
+    }
     /// Sets object `me` up at the start time; it may send messages.
     fn init(&self, ctx: &mut Ctx<'_, Self>, me: u32, state: &mut Self::State);
     /// Runs object `me` over one batch of messages, all with the virtual time `ctx.now()`.

@@ -300,6 +300,7 @@ impl Region {
         let (from, to) = (self.slots[i as usize].cell, self.cold[i as usize].cross.1);
         self.grid.remove_from(i, from);
         self.grid.insert(i, to);
+        self.touch(to);
         self.slots[i as usize].cell = to;
         if self.mine(i) && self.tell_crossing(i, from, to) {
             return self.predict(i);
@@ -340,6 +341,40 @@ impl Region {
             }
         }
         false
+    }
+
+    /// Takes in news from neighbour `from` at key `at` after the region ran its own events on
+    /// to `reached`, past it, if that leaves the region as hearing it at `at` would have: no
+    /// event after `at` read or changed a ball in the 3 × 3 blocks of cells around the ball's
+    /// record and around its new cell (so none read the ball, and none changed what its new
+    /// prediction reads; not asked `again`), and the ball's new first event comes after
+    /// `reached`. False if not; what it changed is in the journal then, to be put back.
+    pub(super) fn take_in(
+        &mut self,
+        from: u32,
+        news: &News,
+        at: &Key,
+        reached: &Key,
+        again: bool,
+    ) -> bool {
+        let gid = match news {
+            News::Enter(g) | News::Update(g) | News::Hand(g) => g.gid,
+            News::Leave(gid) => *gid,
+        };
+        let old = self.local_of(gid).map(|i| self.slots[i as usize].cell);
+        if !again && old.is_some_and(|c| self.touched_near(c, at.t)) {
+            return false;
+        }
+        // what the news changes stamps nothing: the executor takes in no earlier news after it
+        self.set_touching(false);
+        self.hear(from, news, at.t);
+        self.set_touching(true);
+        let Some(i) = self.local_of(gid) else {
+            return true; // forgotten
+        };
+        let cell = self.slots[i as usize].cell;
+        let touched = !again && self.touched_near(cell, at.t);
+        cell == NOWHERE || (!touched && self.cold[i as usize].queued > *reached)
     }
 
     /// Takes in news from neighbour `from` at time `now`.

@@ -406,6 +406,33 @@ impl Model for Regions {
         true
     }
 
+    fn may_take_in(msg: &RegionMsg) -> bool {
+        matches!(msg, RegionMsg::News(_))
+    }
+
+    fn take_in(
+        &self,
+        ctx: &mut Ctx<'_, Self>,
+        _me: u32,
+        state: &mut Region,
+        batch: &[Envelope<RegionMsg>],
+        again: bool,
+    ) -> bool {
+        // news that touches nothing the region ran past it is taken in at its key: the
+        // region's state is then the one hearing it in its turn gives
+        let (at, reached) = (ctx.now().key.clone(), ctx.reached().key.clone());
+        state.begin(ctx.journal());
+        let taken = batch.iter().all(|env| match &env.msg {
+            RegionMsg::News(news) => state.take_in(env.from, news, &at, &reached, again),
+            RegionMsg::Wake => false,
+        });
+        if taken {
+            self.schedule(ctx, state);
+        }
+        state.end(ctx.journal());
+        taken
+    }
+
     fn cut(&self, ctx: &mut Ctx<'_, Self>, _me: u32, state: &mut Region) {
         // the events kept sent nothing: only the wake-up for the next one is missing
         state.begin(ctx.journal());

@@ -176,6 +176,12 @@ pub struct Region {
     /// The stretch of the batch being run: a batch's start, or one of its own events it runs
     /// on to ([`Region::next_stretch`]).
     stretch: u32,
+    /// By cell: the latest time an event read or changed a ball there (while journaling),
+    /// its own run on or undone since: what [`Region::take_in`] asks. Not journaled: the
+    /// stamps of events undone only make it refuse more.
+    touched: Vec<f64>,
+    /// Whether changes stamp their cells (not while news is taken in).
+    touching: bool,
     /// News for the neighbours from the batch being run, in order.
     pub(super) outbox: Vec<(u32, News)>,
     /// Events the batch being run reports, each at its key.
@@ -186,6 +192,7 @@ impl Region {
     /// An empty region of `shape`.
     pub(super) fn new(shape: Arc<Shape>, start: f64) -> Region {
         let grid = Grid::with_dims(&shape.table, 0, shape.rmax, (shape.columns, shape.rows));
+        let cells = (shape.columns * shape.rows) as usize;
         Region {
             shape,
             slots: Vec::new(),
@@ -200,6 +207,8 @@ impl Region {
             journal: Vec::new(),
             kept: Vec::new(),
             stretch: 0,
+            touched: vec![f64::NEG_INFINITY; cells],
+            touching: true,
             outbox: Vec::new(),
             reports: Vec::new(),
         }
@@ -297,8 +306,30 @@ impl Region {
         if self.kept[k] != self.stretch {
             self.kept[k] = self.stretch;
             let (s, c) = (self.slots[k], self.cold[k].clone());
+            self.touch(s.cell);
             self.journal.push(Undo::Ball(i, s, c));
         }
+    }
+
+    /// Stamps cell `c` (if any) with the time of the batch being run: a ball there was read
+    /// or changed ([`Region::touched_near`]).
+    #[inline]
+    pub(super) fn touch(&mut self, c: u32) {
+        if self.touching && self.journaling && c != NOWHERE {
+            let t = &mut self.touched[c as usize];
+            *t = t.max(self.now);
+        }
+    }
+
+    /// Whether an event at `t` or later read or changed a ball in the 3 × 3 block of cells
+    /// around cell `c` (never for a record on no cell).
+    pub(super) fn touched_near(&self, c: u32, t: f64) -> bool {
+        c != NOWHERE && (self.grid.cells_near(c)).any(|k| self.touched[k as usize] >= t)
+    }
+
+    /// Sets whether changes stamp their cells.
+    pub(super) fn set_touching(&mut self, on: bool) {
+        self.touching = on;
     }
 
     /// The pending wake-up.

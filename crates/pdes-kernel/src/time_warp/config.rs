@@ -145,6 +145,11 @@ pub struct TwStats {
     pub ran_on: u64,
     /// Of them, events undone by a cut or a rollback.
     pub ran_on_undone: u64,
+    /// Batches taken in after a batch of their object that ran past them
+    /// ([`Model::take_in`](crate::Model::take_in)), instead of cutting it back.
+    pub taken_in: u64,
+    /// Batches the model could not take in that way: their object was cut back for them.
+    pub take_in_refused: u64,
     /// Messages sent to an object on another worker.
     pub remote_messages: u64,
     /// Messages sent in all (local and remote, rolled-back sends included).
@@ -189,6 +194,8 @@ impl TwStats {
         self.cuts += o.cuts;
         self.ran_on += o.ran_on;
         self.ran_on_undone += o.ran_on_undone;
+        self.taken_in += o.taken_in;
+        self.take_in_refused += o.take_in_refused;
         self.remote_messages += o.remote_messages;
         self.messages += o.messages;
         self.anti_messages += o.anti_messages;

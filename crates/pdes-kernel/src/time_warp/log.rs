@@ -131,6 +131,19 @@ impl<T> Log<T> {
         })
     }
 
+    /// The records of `chain`, latest first.
+    pub fn newest_first<'a>(&'a self, chain: &Chain) -> impl Iterator<Item = &'a T> {
+        let mut n = chain.last;
+        std::iter::from_fn(move || {
+            if n == NONE {
+                return None;
+            }
+            let e = self.entry(n);
+            n = e.prev;
+            Some(e.item.as_ref().expect("live"))
+        })
+    }
+
     /// Takes the latest record of `chain`.
     pub fn pop_last(&mut self, chain: &mut Chain) -> Option<T> {
         (chain.last != NONE).then(|| self.unlink(chain, chain.last))

@@ -234,6 +234,14 @@ impl<M: Model> Done<M> {
     fn end(&self) -> &VTime<M::Time> {
         reached(&self.time, &self.span)
     }
+
+    /// Whether it was taken in after batches of its object that ran past it
+    /// ([`Model::take_in`]): it reached their end without running on.
+    fn taken_in(&self) -> bool {
+        self.span
+            .as_ref()
+            .is_some_and(|s| s.marks.is_empty() && s.end > self.time)
+    }
 }
 
 /// The time a batch at `time` reached: its own, or the end of its `span`.
@@ -314,6 +322,17 @@ struct Lp<M: Model> {
     /// Whether its latest batch was cut back ([`Worker::cut`]) and waits to be ended anew
     /// ([`Model::cut`]).
     cut: bool,
+    /// Batches it had taken in after batches that ran past them, undone for a message later
+    /// than they are, latest first: taken in again as they were ([`Worker::retake`]).
+    retakes: Vec<Late<M>>,
+}
+
+/// A batch taken in after batches that ran past it, undone for a later message
+/// ([`Lp::retakes`]).
+struct Late<M: Model> {
+    time: VTime<M::Time>,
+    inputs: Vec<Input>,
+    batch: Vec<Envelope<M::Msg>>,
 }
 
 /// Where each object lives: its worker and its index there.
@@ -440,6 +459,8 @@ pub struct Worker<M: Model> {
     runs_ahead: bool,
     /// Local objects whose latest batch was cut back, to be ended anew before anything else.
     cuts: Vec<u32>,
+    /// Local objects with batches to take in again ([`Lp::retakes`]), before anything else.
+    retaking: Vec<u32>,
     /// What the collector needs of committed batches, until the chunk of the first GVT round
     /// that passes them: the collector puts out a round's batches after the round before's,
     /// and a batch run as final may be later than one another worker commits a round after.
@@ -487,6 +508,7 @@ impl<M: Model> Worker<M> {
                     active: false,
                     waiting: None,
                     cut: false,
+                    retakes: Vec::new(),
                 })
                 .collect(),
             placement,
@@ -535,6 +557,7 @@ impl<M: Model> Worker<M> {
             outbox_floor: Floor::INFINITY,
             runs_ahead: false,
             cuts: Vec::new(),
+            retaking: Vec::new(),
             to_ship: Vec::new(),
         }
     }
@@ -645,8 +668,14 @@ impl<M: Model> Worker<M> {
             Op::Cancel { .. } | Op::Retract { .. } => &self.cancel_floor,
         };
         if floor.reaches(time, obj) {
+            let kind = match op {
+                Op::Msg { .. } => "a message",
+                Op::Anti { .. } => "an anti-message",
+                Op::Cancel { .. } => "a cancellation",
+                Op::Retract { .. } => "a retraction",
+            };
             self.fault.get_or_insert(format!(
-                "time warp: an op for object {to} at t = {} came after a later batch ran as final",
+                "time warp: {kind} for object {to} at t = {} came after a later batch ran as final",
                 time.t()
             ));
         }
@@ -660,16 +689,14 @@ impl<M: Model> Worker<M> {
                     self.marks.set_aside(uid, p, Mark::Cancelled, self.gvt.t);
                     return;
                 }
-                if self.ran_past(li, &p.time) {
-                    self.straggler(li, &p.time);
-                }
+                self.arrives(li, &p);
                 self.push(Item { uid, p });
             }
             Op::Anti { uid, time, .. } => {
                 // a cancelled message was handled by no batch that stands
                 let unseen = self.marks.cancelled(uid);
                 if !self.marks.annul(uid) && !unseen {
-                    self.undo_handling(li, &time);
+                    self.undo_from(li, &time);
                 }
             }
             Op::Retract { h, at, by } => self.retract(h, &at, by),
@@ -759,42 +786,123 @@ impl<M: Model> Worker<M> {
     /// Undoes every batch of local object `li` that reached `time` or later.
     fn rollback(&mut self, li: usize, time: &VTime<M::Time>) {
         self.stats.rollbacks += 1;
+        self.release_retakes(li, time);
         while self.last_reached(li).is_some_and(|t| t >= time) {
-            self.undo_last(li);
+            self.undo_last(li, time);
+        }
+    }
+
+    /// Puts the messages of local object `li`'s batches to take in again at `time` or later
+    /// back in the heap: a message at `time` undoes the object back before them.
+    fn release_retakes(&mut self, li: usize, time: &VTime<M::Time>) {
+        let lp = &mut self.lps[li];
+        if lp.retakes.iter().all(|l| l.time < *time) {
+            return;
+        }
+        let (to, retakes) = (lp.id, std::mem::take(&mut lp.retakes));
+        for late in retakes {
+            if late.time < *time {
+                self.lps[li].retakes.push(late);
+            } else {
+                self.put_back(to, &late.time, late.inputs, late.batch);
+            }
+        }
+    }
+
+    /// Puts the messages of a batch of object `to` at `time` back in the heap.
+    fn put_back(
+        &mut self,
+        to: u32,
+        time: &VTime<M::Time>,
+        mut inputs: Vec<Input>,
+        mut batch: Vec<Envelope<M::Msg>>,
+    ) {
+        for (i, env) in inputs.drain(..).zip(batch.drain(..)) {
+            self.note_waiting(to, time);
+            self.heap.push(i.into_item(env, time, to), false);
+        }
+        give(&mut self.spare.inputs, inputs);
+        give(&mut self.spare.batches, batch);
+    }
+
+    /// Readies local object `li` for message `p` that has just come for it: rolls it back if
+    /// it ran past the message, unless the message may wait to be taken in after the batch
+    /// that did ([`Worker::may_take_in`]).
+    #[inline(always)]
+    fn arrives(&mut self, li: usize, p: &Pending<M::Time, M::Msg>) {
+        if self.ran_past(li, &p.time) && !self.may_take_in(li, p) {
+            self.straggler(li, &p.time);
+        }
+    }
+
+    /// Whether message `p` for local object `li`, which ran past it, may wait for its turn to
+    /// be taken in after the object's latest batch ([`Model::take_in`]) instead of cutting it
+    /// back: the model allows it for the message, and the batches that reached its time are
+    /// journaled ([`Worker::late_ok`]).
+    fn may_take_in(&self, li: usize, p: &Pending<M::Time, M::Msg>) -> bool {
+        M::may_take_in(&p.env.msg) && self.late_ok(li, &p.time)
+    }
+
+    /// Whether a batch at `time` of local object `li`, which ran past it, may be taken in
+    /// after its latest batch: the collector does not read states (which it would see out of
+    /// order), every uncommitted batch of the object that reached `time` is journaled, none
+    /// is at `time` itself (a batch at that time must run again with it), and none taken in
+    /// so is later (the model checks what the batch would change against the events run past
+    /// it, not against batches taken in).
+    fn late_ok(&self, li: usize, time: &VTime<M::Time>) -> bool {
+        !self.ship
+            && (self.log.newest_first(&self.lps[li].history))
+                .take_while(|d| d.end() >= time)
+                .all(|d| {
+                    let later_taken_in = d.time > *time && d.taken_in();
+                    d.time != *time && !later_taken_in && matches!(d.saved, Saved::Journal(..))
+                })
+    }
+
+    /// Undoes every uncommitted batch of local object `li` at `time` or later, and every one
+    /// taken in after a batch that reached `time`: one of them may have handled a message at
+    /// `time` that is gone. A batch before `time` that ran its own events on past it stands:
+    /// it ran before the message came (which then cut it back, or waited to be taken in after
+    /// it), so no event of it saw the message.
+    fn undo_from(&mut self, li: usize, time: &VTime<M::Time>) {
+        let undone = |d: &Done<M>| *d.end() >= *time && (d.time >= *time || d.taken_in());
+        self.release_retakes(li, time);
+        if (self.log.last(&self.lps[li].history)).is_some_and(undone) {
+            self.stats.rollbacks += 1;
+            while (self.log.last(&self.lps[li].history)).is_some_and(undone) {
+                self.undo_last(li, time);
+            }
         }
     }
 
     /// Rolls local object `li` back for a message that came for it at `time`, after it ran
     /// past it: a batch that ran its object's own events on across `time` is cut back to the
-    /// last of them before it ([`Worker::cut`]), every later batch undone.
+    /// last of them before it ([`Worker::cut`]), every later batch undone (a batch taken in
+    /// after it among them).
     fn straggler(&mut self, li: usize, time: &VTime<M::Time>) {
         self.stats.rollbacks += 1;
-        while self
-            .log
-            .last(&self.lps[li].history)
-            .is_some_and(|d| d.time >= *time)
-        {
-            self.undo_last(li);
-        }
-        let Some(d) = self.log.last(&self.lps[li].history) else {
-            return;
-        };
-        if *d.end() < *time {
-            return;
-        }
-        let marked = d.span.as_ref().is_some_and(|s| !s.marks.is_empty());
-        if !marked || !matches!(d.saved, Saved::Journal(..)) {
-            self.undo_last(li);
-        } else {
-            self.cut(li, time);
+        self.release_retakes(li, time);
+        while let Some(d) = self.log.last(&self.lps[li].history) {
+            if *d.end() < *time {
+                return;
+            }
+            let marked = d.span.as_ref().is_some_and(|s| !s.marks.is_empty());
+            if d.time < *time && marked && matches!(d.saved, Saved::Journal(..)) {
+                return self.cut(li, time);
+            }
+            self.undo_last(li, time);
         }
     }
 
-    /// Undoes local object `li`'s latest uncommitted batch: restores the state before it,
-    /// puts its messages back, and annuls what it sent and cancelled.
-    fn undo_last(&mut self, li: usize) {
+    /// Undoes local object `li`'s latest uncommitted batch for a message at `time`: restores
+    /// the state before it, puts its messages back, and annuls what it sent and cancelled. A
+    /// batch taken in before `time` after batches that ran past it is taken in again instead
+    /// ([`Worker::retake`]): handled in its turn, it could undo events of theirs before
+    /// `time`, and what they sent, below this worker's floor.
+    fn undo_last(&mut self, li: usize, time: &VTime<M::Time>) {
         let lp = &mut self.lps[li];
         let d = self.log.pop_last(&mut lp.history).expect("a batch to undo");
+        let retake = d.taken_in() && d.time < *time;
         lp.cut = false;
         self.uncommitted -= 1;
         self.stats.rolled_back += 1;
@@ -815,13 +923,19 @@ impl<M: Model> Worker<M> {
         let lp = &mut self.lps[li];
         lp.seq = d.pre_seq;
         let to = lp.id;
-        let (mut inputs, mut batch) = (d.inputs, d.batch);
-        for (i, env) in inputs.drain(..).zip(batch.drain(..)) {
-            self.note_waiting(to, &d.time);
-            self.heap.push(i.into_item(env, &d.time, to), false);
+        if retake {
+            if lp.retakes.is_empty() {
+                self.retaking.push(li as u32);
+            }
+            let (time, inputs, batch) = (d.time, d.inputs, d.batch);
+            lp.retakes.push(Late {
+                time,
+                inputs,
+                batch,
+            });
+        } else {
+            self.put_back(to, &d.time, d.inputs, d.batch);
         }
-        give(&mut self.spare.inputs, inputs);
-        give(&mut self.spare.batches, batch);
         let (mut sent, mut cancels) = (d.sent, d.cancels);
         self.annul(to, &end, &mut sent, &mut cancels);
         give(&mut self.spare.sent, sent);
@@ -908,10 +1022,40 @@ impl<M: Model> Worker<M> {
     /// Ends anew, by the model ([`Model::cut`]), every batch cut back since the last call,
     /// and sends what it sends then.
     fn resume_cuts(&mut self, model: &M) {
-        while !self.cuts.is_empty() {
+        while !self.cuts.is_empty() || !self.retaking.is_empty() {
             self.resume_cuts_once(model);
             self.drain_local();
+            self.retake(model);
         }
+    }
+
+    /// Takes in again, oldest first, the batches undone for a later message that had been
+    /// taken in after batches that ran past them ([`Lp::retakes`]), once their objects' cuts
+    /// are ended anew: the batches they follow are what they followed then, cut back, so the
+    /// model need not check those again ([`Model::take_in`]). A batch whose object no longer
+    /// runs past it waits in the heap for its turn.
+    fn retake(&mut self, model: &M) {
+        while let Some(li) = self.retaking.pop() {
+            let li = li as usize;
+            while let Some(late) = self.lps[li].retakes.pop() {
+                if !self.ran_past(li, &late.time) {
+                    let to = self.lps[li].id;
+                    self.put_back(to, &late.time, late.inputs, late.batch);
+                    continue;
+                }
+                let taken = Taken {
+                    to: self.lps[li].id,
+                    li,
+                    inputs: late.inputs,
+                    batch: late.batch,
+                    cancellable: false,
+                    next: None,
+                    saved: None,
+                };
+                self.take_late(model, late.time, taken, true);
+            }
+        }
+        self.drain_local();
     }
 
     /// Ends anew the batches cut back so far ([`Worker::resume_cuts`]).
@@ -1067,7 +1211,7 @@ impl<M: Model> Worker<M> {
     /// run as final); false when there is none.
     #[inline(always)]
     fn step<F: Fabric<M>>(&mut self, model: &M, fabric: &F, limit: f64, final_only: bool) -> bool {
-        if !self.cuts.is_empty() {
+        if !self.cuts.is_empty() || !self.retaking.is_empty() {
             self.resume_cuts(model);
         }
         match self.next_time() {
@@ -1078,6 +1222,10 @@ impl<M: Model> Worker<M> {
             return false;
         }
         let (time, mut taken) = self.take_batch();
+        if self.ran_past(taken.li, &time) {
+            self.take_late(model, time, taken, false);
+            return true;
+        }
         let run_final = self.settle_final(model, fabric, &time, &mut taken);
         // the next batch's object, most likely (a local one: its message is here): where it
         // lives now, and its record once the handler has run (not at once: the record's place
@@ -1141,12 +1289,81 @@ impl<M: Model> Worker<M> {
             prefetch_all(&self.lps[self.placement.local(next)]);
         }
         self.spare.pending = sent;
+        self.route_all(ops);
+        true
+    }
+
+    /// Routes the ops a batch made, then the local ones they lead to.
+    #[inline(always)]
+    fn route_all(&mut self, mut ops: Vec<Op<M::Time, M::Msg>>) {
         for op in ops.drain(..) {
             self.route(op);
         }
         self.spare.ops = ops;
         self.drain_local();
-        true
+    }
+
+    /// Runs a batch that waited for its turn after its object's latest batch ran past it
+    /// ([`Worker::may_take_in`]), or one to take in `again` ([`Worker::retake`]): the model
+    /// takes it in after that batch if it can ([`Model::take_in`]), and it is filed as
+    /// reaching as far; if not, what the model saved is put back, the object is cut back to
+    /// before the batch, and the batch waits in the heap again for its turn.
+    fn take_late(&mut self, model: &M, time: VTime<M::Time>, mut taken: Taken<M>, again: bool) {
+        let (to, li) = (taken.to, taken.li);
+        let offered = taken.batch.iter().all(|e| M::may_take_in(&e.msg)) && self.late_ok(li, &time);
+        if offered {
+            let end = self.last_reached(li).expect("a batch ran past").clone();
+            let Saved::Journal(mut journal, restore) = self.save_state(model, to, li) else {
+                unreachable!("a journaled object's batch saves a journal");
+            };
+            let lp = &mut self.lps[li];
+            let (pre_seq, first) = (lp.seq, lp.uids);
+            let mut ctx = Ctx::speculative(model, time.clone(), to, &mut lp.seq)
+                .named(&mut lp.uids)
+                .journaled(&mut journal);
+            ctx.reached = Some(end.clone());
+            ctx.sent = std::mem::take(&mut self.spare.pending);
+            let taken_in = model.take_in(&mut ctx, to, &mut lp.state, &taken.batch, again);
+            debug_assert!(taken_in || !again, "a batch taken in again is taken in");
+            let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
+            let into_past = ctx.into_past;
+            if taken_in {
+                assert!(output.is_empty(), "a batch taken in emits nothing");
+                self.stats.taken_in += 1;
+                self.stats.processed += 1;
+                taken.saved = Some(Saved::Journal(journal, restore));
+                let span = Some(Box::new(Span {
+                    end,
+                    output_times: Vec::new(),
+                    marks: Vec::new(),
+                }));
+                let mut ops = std::mem::take(&mut self.spare.ops);
+                let did = Did {
+                    time,
+                    span,
+                    uids: first,
+                    pre_seq,
+                    delivered: taken.batch.len(),
+                    cancelled: &cancelled,
+                    output,
+                    into_past,
+                };
+                self.log_batch(model, taken, did, &mut sent, &mut ops);
+                self.spare.pending = sent;
+                self.route_all(ops);
+                return;
+            }
+            while let Some(undo) = journal.pop() {
+                restore(&mut lp.state, undo);
+            }
+            give(&mut self.spare.journals, journal);
+            (lp.seq, lp.uids) = (pre_seq, first);
+            sent.clear();
+            self.spare.pending = sent;
+        }
+        self.stats.take_in_refused += 1;
+        self.straggler(li, &time);
+        self.put_back(to, &time, taken.inputs, taken.batch);
     }
 
     /// Whether the batch at the head of the queue may run as final. The first batch left at
@@ -1168,8 +1385,8 @@ impl<M: Model> Worker<M> {
         }
         let li = self.placement.local(to);
         debug_assert!(
-            self.last_reached(li).is_none_or(|t| *t < time),
-            "batches run in order"
+            self.last_reached(li).is_none_or(|t| *t < time) || self.may_take_in(li, &head.p),
+            "batches run in order, or wait to be taken in"
         );
         let mut inputs = take(&mut self.spare.inputs);
         let mut batch = take(&mut self.spare.batches);
@@ -1365,9 +1582,7 @@ impl<M: Model> Worker<M> {
         }
         debug_assert!(!self.final_floor.reaches(&p.time, p.to), "sends go forward");
         let li = self.placement.local(p.to);
-        if self.ran_past(li, &p.time) {
-            self.straggler(li, &p.time);
-        }
+        self.arrives(li, &p);
         self.push(Item { uid, p });
         self.note_entries();
     }
