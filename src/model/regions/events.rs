@@ -190,6 +190,7 @@ impl Region {
     /// Sets record `i` on a new course from `key` on.
     fn turn(&mut self, i: u32, key: &Key, velocity: Vec2) {
         self.keep(i);
+        self.touch(self.slots[i as usize].cell);
         let s = &mut self.slots[i as usize];
         s.traj = Trajectory {
             position: s.traj.at(key.t),
@@ -300,8 +301,12 @@ impl Region {
         let (from, to) = (self.slots[i as usize].cell, self.cold[i as usize].cross.1);
         self.grid.remove_from(i, from);
         self.grid.insert(i, to);
-        self.touch(to);
+        if self.mine(i) {
+            self.touch(from);
+            self.touch(to);
+        }
         self.slots[i as usize].cell = to;
+        self.cold[i as usize].moved = self.now;
         if self.mine(i) && self.tell_crossing(i, from, to) {
             return self.predict(i);
         }
@@ -344,11 +349,14 @@ impl Region {
     }
 
     /// Takes in news from neighbour `from` at key `at` after the region ran its own events on
-    /// to `reached`, past it, if that leaves the region as hearing it at `at` would have: no
-    /// event after `at` read or changed a ball in the 3 × 3 blocks of cells around the ball's
-    /// record and around its new cell (so none read the ball, and none changed what its new
-    /// prediction reads; not asked `again`), and the ball's new first event comes after
-    /// `reached`. False if not; what it changed is in the journal then, to be put back.
+    /// to `reached`, past it, if that leaves the region as hearing it at `at` would have. It
+    /// does when (unless asked `again`) the ball's record has not changed cells since `at`,
+    /// no ball turned and no ball of the region changed cells after `at` in the 3 × 3 blocks
+    /// of cells around the record and around the ball's new cell, and the ball's new first
+    /// event comes after `reached`. The events run since then met nothing the news changes,
+    /// and the ball's new course meets nothing before `reached`: a prediction that read the
+    /// old course only finds a stale event later, as in the event list. False if not; what
+    /// it changed is in the journal then, to be put back.
     pub(super) fn take_in(
         &mut self,
         from: u32,
@@ -361,8 +369,11 @@ impl Region {
             News::Enter(g) | News::Update(g) | News::Hand(g) => g.gid,
             News::Leave(gid) => *gid,
         };
-        let old = self.local_of(gid).map(|i| self.slots[i as usize].cell);
-        if !again && old.is_some_and(|c| self.touched_near(c, at.t)) {
+        let old = self.local_of(gid).map(|i| i as usize);
+        // a record that changed cells since is placed by the cell it is in (its column)
+        let moved = old.is_some_and(|i| self.cold[i].moved >= at.t);
+        let old = old.map(|i| self.slots[i].cell);
+        if !again && (moved || old.is_some_and(|c| self.touched_near(c, at.t))) {
             return false;
         }
         // what the news changes stamps nothing: the executor takes in no earlier news after it

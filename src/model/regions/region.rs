@@ -66,6 +66,8 @@ pub struct Cold {
     pub(super) queued: Key,
     /// Where its entry is in the calendar.
     pub(super) place: Place,
+    /// When it last changed cells, or was placed in one.
+    pub(super) moved: f64,
 }
 
 /// The old value of one part of a region, recorded before a batch changes it, so that Time
@@ -176,9 +178,9 @@ pub struct Region {
     /// The stretch of the batch being run: a batch's start, or one of its own events it runs
     /// on to ([`Region::next_stretch`]).
     stretch: u32,
-    /// By cell: the latest time an event read or changed a ball there (while journaling),
-    /// its own run on or undone since: what [`Region::take_in`] asks. Not journaled: the
-    /// stamps of events undone only make it refuse more.
+    /// By cell: the latest time a ball there turned, or a ball of the region left or entered
+    /// it (while journaling), in events run on or undone since: what [`Region::take_in`]
+    /// asks. Not journaled: the stamps of events undone only make it refuse more.
     touched: Vec<f64>,
     /// Whether changes stamp their cells (not while news is taken in).
     touching: bool,
@@ -306,13 +308,12 @@ impl Region {
         if self.kept[k] != self.stretch {
             self.kept[k] = self.stretch;
             let (s, c) = (self.slots[k], self.cold[k].clone());
-            self.touch(s.cell);
             self.journal.push(Undo::Ball(i, s, c));
         }
     }
 
-    /// Stamps cell `c` (if any) with the time of the batch being run: a ball there was read
-    /// or changed ([`Region::touched_near`]).
+    /// Stamps cell `c` (if any) with the time of the event being run: a ball there turned, or
+    /// one of the region's balls left or entered it ([`Region::touched_near`]).
     #[inline]
     pub(super) fn touch(&mut self, c: u32) {
         if self.touching && self.journaling && c != NOWHERE {
@@ -321,8 +322,8 @@ impl Region {
         }
     }
 
-    /// Whether an event at `t` or later read or changed a ball in the 3 × 3 block of cells
-    /// around cell `c` (never for a record on no cell).
+    /// Whether an event at `t` or later stamped a cell of the 3 × 3 block around cell `c`
+    /// (never for a record on no cell).
     pub(super) fn touched_near(&self, c: u32, t: f64) -> bool {
         c != NOWHERE && (self.grid.cells_near(c)).any(|k| self.touched[k as usize] >= t)
     }
@@ -467,6 +468,7 @@ impl Region {
             phys: (never.clone(), Partner::Nothing),
             queued: never,
             place: Place::NOWHERE,
+            moved: self.now,
         };
         i
     }
@@ -502,6 +504,7 @@ impl Region {
                     phys: (never.clone(), Partner::Nothing),
                     queued: never,
                     place: Place::NOWHERE,
+                    moved: f64::NEG_INFINITY,
                 });
                 self.grid.hold_balls(self.slots.len());
                 i
