@@ -306,7 +306,9 @@ impl Region {
             self.touch(to);
         }
         self.slots[i as usize].cell = to;
-        self.cold[i as usize].moved = self.now;
+        if self.grid.column(from) != self.grid.column(to) {
+            self.cold[i as usize].column_since = self.now;
+        }
         if self.mine(i) && self.tell_crossing(i, from, to) {
             return self.predict(i);
         }
@@ -350,7 +352,7 @@ impl Region {
 
     /// Takes in news from neighbour `from` at key `at` after the region ran its own events on
     /// to `reached`, past it, if that leaves the region as hearing it at `at` would have. It
-    /// does when (unless asked `again`) the ball's record has not changed cells since `at`,
+    /// does when (unless asked `again`) a ghost's record has not changed columns since `at`,
     /// no ball turned and no ball of the region changed cells after `at` in the 3 × 3 blocks
     /// of cells around the record and around the ball's new cell, and the ball's new first
     /// event comes after `reached`. The events run since then met nothing the news changes,
@@ -370,8 +372,10 @@ impl Region {
             News::Leave(gid) => *gid,
         };
         let old = self.local_of(gid).map(|i| i as usize);
-        // a record that changed cells since is placed by the cell it is in (its column)
-        let moved = old.is_some_and(|i| self.cold[i].moved >= at.t);
+        // news of a ghost places it in the column its record is in: the one it was in then (a
+        // ball handed over goes to the border column)
+        let placed = !matches!(news, News::Hand(_));
+        let moved = placed && old.is_some_and(|i| self.cold[i].column_since >= at.t);
         let old = old.map(|i| self.slots[i].cell);
         if !again && (moved || old.is_some_and(|c| self.touched_near(c, at.t))) {
             return false;

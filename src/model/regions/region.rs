@@ -66,8 +66,8 @@ pub struct Cold {
     pub(super) queued: Key,
     /// Where its entry is in the calendar.
     pub(super) place: Place,
-    /// When it last changed cells, or was placed in one.
-    pub(super) moved: f64,
+    /// When it last changed grid columns, or was placed in one.
+    pub(super) column_since: f64,
 }
 
 /// The old value of one part of a region, recorded before a batch changes it, so that Time
@@ -468,7 +468,7 @@ impl Region {
             phys: (never.clone(), Partner::Nothing),
             queued: never,
             place: Place::NOWHERE,
-            moved: self.now,
+            column_since: self.now,
         };
         i
     }
@@ -504,7 +504,7 @@ impl Region {
                     phys: (never.clone(), Partner::Nothing),
                     queued: never,
                     place: Place::NOWHERE,
-                    moved: f64::NEG_INFINITY,
+                    column_since: f64::NEG_INFINITY,
                 });
                 self.grid.hold_balls(self.slots.len());
                 i
