@@ -119,23 +119,18 @@ impl<T> Log<T> {
 
     /// The records of `chain` after its oldest, latest first.
     pub fn after_first_newest_first<'a>(&'a self, chain: &Chain) -> impl Iterator<Item = &'a T> {
-        let first = chain.first;
-        let mut n = chain.last;
-        std::iter::from_fn(move || {
-            if n == first {
-                return None;
-            }
-            let e = self.entry(n);
-            n = e.prev;
-            Some(e.item.as_ref().expect("live"))
-        })
+        self.back_from(chain.last, chain.first)
     }
 
     /// The records of `chain`, latest first.
     pub fn newest_first<'a>(&'a self, chain: &Chain) -> impl Iterator<Item = &'a T> {
-        let mut n = chain.last;
+        self.back_from(chain.last, NONE)
+    }
+
+    /// The records of a chain from record `n` back to record `stop`, `stop` left out.
+    fn back_from(&self, mut n: u64, stop: u64) -> impl Iterator<Item = &T> {
         std::iter::from_fn(move || {
-            if n == NONE {
+            if n == stop || n == NONE {
                 return None;
             }
             let e = self.entry(n);
