@@ -192,6 +192,39 @@ fn a_dense_gas_crosses_borders_often_and_stays_exact() {
 }
 
 #[test]
+fn a_wide_window_takes_news_in_and_stays_exact() {
+    // a wide window: news arrives far inside the spans, most of it is taken in, and what is
+    // refused cuts a long span back and echoes through the neighbour's anti-messages
+    let p = builtin::Params {
+        balls: Some(20_000),
+        area_fraction: Some(0.5),
+        ..Default::default()
+    };
+    let mut s = builtin::build("gas", &p).unwrap();
+    s.until = 1.5;
+    for (window, chaos) in [(3e-3, None), (1e-2, Some(13))] {
+        let tw = TwConfig {
+            workers: 2,
+            chaos,
+            window: Some(window),
+            ..TwConfig::default()
+        };
+        let engine = EngineKind::Regions {
+            count: 2,
+            tw: Some(tw),
+        };
+        assert_eq!(
+            assert_same_checked(&s, &[engine], false),
+            1,
+            "window {window}"
+        );
+        let (_, sum) = traced(&s, engine, false);
+        let tw = sum.time_warp.expect("time warp ran").stats;
+        assert!(tw.taken_in > 0 && tw.cuts > 0, "window {window}: {tw:?}");
+    }
+}
+
+#[test]
 fn too_few_columns_is_refused_with_the_count() {
     let s = builtin::build("cradle", &builtin::Params::default()).unwrap();
     let err = poolsim::model::regions::Regions::new(&s, 500, 0.0)
