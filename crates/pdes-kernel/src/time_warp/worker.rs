@@ -1222,7 +1222,8 @@ impl<M: Model> Worker<M> {
             return false;
         }
         let (time, mut taken) = self.take_batch();
-        if self.ran_past(taken.li, &time) {
+        // only an object that runs ahead has batches that waited behind its span
+        if self.runs_ahead && self.ran_past(taken.li, &time) {
             self.take_late(model, time, taken, false);
             return true;
         }
