@@ -10,22 +10,74 @@
 use super::{Chunk, Committed, Floor, RoundRecord, TwStats};
 use crate::executor::ExecError;
 use crate::sequential::Sink;
-use crate::{MessageStats, Model, VTime};
+use crate::{MessageStats, Model, Time, VTime};
+use std::collections::binary_heap::PeekMut;
 use std::collections::{BTreeMap, BinaryHeap};
 
 /// A model's chunk of committed batches.
 pub(super) type ChunkOf<M> = Chunk<<M as Model>::Time, <M as Model>::State, <M as Model>::Output>;
 
-/// One output, or one observed state, waiting for its turn at the sink.
-struct Held<M: Model> {
+/// A committed batch whose observed state and outputs still wait for their turn at the sink,
+/// in its own order: the state first, then the outputs, each at its time.
+struct Open<M: Model> {
+    /// Its time: the state's, and that of every output without a time of its own.
     time: VTime<M::Time>,
-    obj: u32,
-    /// Its place among those held: a batch's outputs keep their order, its state first.
-    seq: u64,
-    what: Item<M>,
+    /// The object's state after it, when observed; boxed, as a state may be far larger than
+    /// the rest.
+    state: Option<Box<M::State>>,
+    /// Its outputs still to go.
+    output: std::vec::IntoIter<M::Output>,
+    /// Their times, when the batch ran on past its own ([`Committed::times`]).
+    times: std::vec::IntoIter<VTime<M::Time>>,
 }
 
-impl<M: Model> Held<M> {
+impl<M: Model> Open<M> {
+    /// A batch's items in their order: sorted by time, when the model emitted them otherwise.
+    fn of(c: Committed<M::Time, M::State, M::Output>) -> Open<M> {
+        let (mut output, mut times) = (c.output, c.times);
+        if times.windows(2).any(|w| w[1] < w[0]) || times.first().is_some_and(|t| *t < c.time) {
+            times.resize(output.len(), c.time.clone());
+            let mut pairs: Vec<_> = times.into_iter().zip(output).collect();
+            pairs.sort_by(|a, b| a.0.cmp(&b.0));
+            (times, output) = pairs.into_iter().unzip();
+        }
+        Open {
+            time: c.time,
+            state: c.state.map(Box::new),
+            output: output.into_iter(),
+            times: times.into_iter(),
+        }
+    }
+
+    /// The time of its next item, if any; the item is then the one [`Open::take`] gives.
+    fn next_time(&mut self) -> Option<VTime<M::Time>> {
+        if self.state.is_some() {
+            return Some(self.time.clone());
+        }
+        (self.output.len() > 0).then(|| self.times.next().unwrap_or_else(|| self.time.clone()))
+    }
+
+    /// Its next item.
+    fn take(&mut self) -> Item<M> {
+        match self.state.take() {
+            Some(state) => Item::State(state),
+            None => Item::Output(self.output.next().expect("an output left")),
+        }
+    }
+}
+
+/// The batch whose next item is the earliest held: at the top of the collector's heap.
+struct Head<T> {
+    /// Its next item's time.
+    time: VTime<T>,
+    obj: u32,
+    /// The batch's place among those held: batches of one object at one time keep their order.
+    seq: u64,
+    /// Where the batch is kept ([`Collector::open`]).
+    slot: usize,
+}
+
+impl<T: Time> Head<T> {
     fn order(&self, o: &Self) -> std::cmp::Ordering {
         (self.time.cmp(&o.time))
             .then(self.obj.cmp(&o.obj))
@@ -33,31 +85,30 @@ impl<M: Model> Held<M> {
     }
 }
 
-impl<M: Model> PartialEq for Held<M> {
+impl<T: Time> PartialEq for Head<T> {
     fn eq(&self, o: &Self) -> bool {
         self.order(o).is_eq()
     }
 }
 
-impl<M: Model> Eq for Held<M> {}
+impl<T: Time> Eq for Head<T> {}
 
-impl<M: Model> PartialOrd for Held<M> {
+impl<T: Time> PartialOrd for Head<T> {
     fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
         Some(self.cmp(o))
     }
 }
 
 /// The earliest first, for a max-heap.
-impl<M: Model> Ord for Held<M> {
+impl<T: Time> Ord for Head<T> {
     fn cmp(&self, o: &Self) -> std::cmp::Ordering {
         o.order(self)
     }
 }
 
-/// What a [`Held`] carries.
+/// What an [`Open`] batch hands the sink next.
 enum Item<M: Model> {
-    /// The object's state after a batch (boxed: a state may be far larger than an output,
-    /// and the heap moves its items).
+    /// The object's state after the batch.
     State(Box<M::State>),
     /// An output.
     Output(M::Output),
@@ -71,10 +122,15 @@ pub struct Collector<M: Model> {
     pub(super) shipped: bool,
     rounds: BTreeMap<u64, Vec<ChunkOf<M>>>,
     next_round: u64,
-    /// Outputs and states of rounds through, that a worker may still commit an earlier
-    /// output than, earliest on top.
-    held: BinaryHeap<Held<M>>,
-    /// Items held so far.
+    /// Batches of rounds through whose outputs and states wait, as a worker may still commit
+    /// an earlier output: each at its next item's time, the earliest on top. One heap entry
+    /// per batch, not per item: its outputs are in order already.
+    held: BinaryHeap<Head<M::Time>>,
+    /// The batches held, by slot; `None` for a free slot.
+    open: Vec<Option<Open<M>>>,
+    /// Free slots of `open`.
+    free: Vec<usize>,
+    /// Batches held so far.
     seq: u64,
     /// Workers' final states, held until every round before them has gone to the sink: a
     /// worker's last chunk can arrive before another worker's chunk of their last round.
@@ -100,6 +156,8 @@ impl<M: Model> Collector<M> {
             rounds: BTreeMap::new(),
             next_round: 1,
             held: BinaryHeap::new(),
+            open: Vec::new(),
+            free: Vec::new(),
             seq: 0,
             finals: Vec::new(),
             lasts: 0,
@@ -157,29 +215,29 @@ impl<M: Model> Collector<M> {
 
     /// Holds a committed batch's state and outputs, each at its time.
     fn hold(&mut self, c: Committed<M::Time, M::State, M::Output>) {
-        let (time, obj) = (c.time, c.obj);
-        if let Some(state) = c.state {
-            let (what, seq, time) = (Item::State(Box::new(state)), self.seq, time.clone());
-            self.seq += 1;
-            self.held.push(Held {
-                time,
-                obj,
-                seq,
-                what,
-            });
-        }
-        let mut times = c.times.into_iter();
-        for o in c.output {
-            let time = times.next().unwrap_or_else(|| time.clone());
-            let (what, seq) = (Item::Output(o), self.seq);
-            self.seq += 1;
-            self.held.push(Held {
-                time,
-                obj,
-                seq,
-                what,
-            });
-        }
+        let obj = c.obj;
+        let mut batch = Open::of(c);
+        let Some(time) = batch.next_time() else {
+            return;
+        };
+        let slot = match self.free.pop() {
+            Some(k) => {
+                self.open[k] = Some(batch);
+                k
+            }
+            None => {
+                self.open.push(Some(batch));
+                self.open.len() - 1
+            }
+        };
+        let seq = self.seq;
+        self.seq += 1;
+        self.held.push(Head {
+            time,
+            obj,
+            seq,
+            slot,
+        });
     }
 
     /// Hands the sink, in order, every held output and state that `open` has passed.
@@ -190,17 +248,27 @@ impl<M: Model> Collector<M> {
         sink: &mut Sink<'_, M, E>,
         failed: &mut Option<ExecError<E>>,
     ) {
-        while self
-            .held
-            .peek()
-            .is_some_and(|h| open.passed(&h.time, h.obj))
-        {
-            let h = self.held.pop().expect("a top");
+        while let Some(mut top) = self.held.peek_mut() {
+            if !open.passed(&top.time, top.obj) {
+                break;
+            }
+            let (obj, slot) = (top.obj as usize, top.slot);
+            let batch = self.open[slot].as_mut().expect("a held batch");
+            let item = batch.take();
+            match batch.next_time() {
+                // the batch goes down the heap to its next item's place
+                Some(time) => top.time = time,
+                None => {
+                    PeekMut::pop(top);
+                    self.open[slot] = None;
+                    self.free.push(slot);
+                }
+            }
             if failed.is_some() {
                 continue;
             }
-            match h.what {
-                Item::State(state) => self.states[h.obj as usize] = *state,
+            match item {
+                Item::State(state) => self.states[obj] = *state,
                 Item::Output(o) => {
                     let states: &[M::State] = if self.shipped { &self.states } else { &[] };
                     if let Err(e) = sink(model, states, o) {
@@ -335,5 +403,32 @@ mod tests {
         c.take(&Tagged, 2, chunk(0, 2, vec![], 3.5), &mut sink, &mut failed);
         assert_eq!(*seen.borrow(), vec![10, 20, 21, 25, 30]);
         assert!(failed.is_none());
+    }
+
+    #[test]
+    fn batches_interleave_by_time_and_keep_their_order_at_one_time() {
+        let mut c: Collector<Tagged> = Collector::new(vec![(), ()]);
+        let seen = std::cell::RefCell::new(Vec::new());
+        let mut failed = None;
+        let mut sink = |_: &Tagged, _: &[()], n: u32| {
+            seen.borrow_mut().push(n);
+            Ok::<(), ()>(())
+        };
+        let batches = vec![
+            batch(1, 1.0, vec![10, 30, 50], &[1.0, 3.0, 5.0]),
+            batch(0, 2.0, vec![20, 40], &[2.0, 4.0]),
+            // the same object and time as an earlier batch: after it
+            batch(1, 3.0, vec![31], &[]),
+            // emitted out of order: given in the order of their times
+            batch(0, 6.0, vec![70, 60], &[7.0, 6.0]),
+        ];
+        c.take(
+            &Tagged,
+            1,
+            chunk(0, 1, batches, 10.0),
+            &mut sink,
+            &mut failed,
+        );
+        assert_eq!(*seen.borrow(), vec![10, 20, 30, 31, 40, 50, 60, 70]);
     }
 }
