@@ -285,12 +285,22 @@ impl Regions {
                 regions[owner as usize + 1].admit(&ghost, owner, Some(0));
             }
         }
-        for r in &mut regions {
-            for i in 0..r.slots.len() as u32 {
-                r.predict(i);
+        // each region predicts its records' first events, the regions on as many threads as
+        // there are cores
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let per = regions.len().div_ceil(threads);
+        std::thread::scope(|scope| {
+            for part in regions.chunks_mut(per) {
+                scope.spawn(move || {
+                    for r in part {
+                        for i in 0..r.slots.len() as u32 {
+                            r.predict(i);
+                        }
+                        r.settle(start);
+                    }
+                });
             }
-            r.settle(start);
-        }
+        });
         let model = Regions {
             table,
             n_balls: balls.len() as u32,
