@@ -68,6 +68,10 @@ pub struct Cold {
     pub(super) place: Place,
     /// When it last changed grid columns, or was placed in one.
     pub(super) column_since: f64,
+    /// The stretch of the batch being run in which its old value was kept last (0: none
+    /// since it was last put back): beside the rest of the record, which the event has
+    /// loaded already, and not in an array of its own, which cost a cache miss per event.
+    kept: u32,
 }
 
 /// The old value of one part of a region, recorded before a batch changes it, so that Time
@@ -96,6 +100,21 @@ pub(super) struct Queued<'a> {
     slots: &'a [Slot],
     cold: &'a mut [Cold],
     grid: &'a Grid,
+    /// The cells' stamps ([`Region::touch`]) while the batch keeps old values: the event will
+    /// stamp the cells of its balls.
+    stamps: Option<&'a [f64]>,
+}
+
+impl Queued<'_> {
+    /// Starts loading cell `c`'s stamp, when the batch stamps.
+    #[inline]
+    fn prefetch_stamp(&self, c: u32) {
+        if let Some(stamps) = self.stamps.filter(|_| c != NOWHERE) {
+            if let Some(t) = stamps.get(c as usize) {
+                prefetch(t);
+            }
+        }
+    }
 }
 
 impl Entries for Queued<'_> {
@@ -122,7 +141,9 @@ impl Entries for Queued<'_> {
     #[inline]
     fn approaching(&self, i: u32) {
         let c = &self.cold[i as usize];
+        self.prefetch_stamp(self.slots[i as usize].cell);
         if c.queued.path[..] == [CELL_CROSSING] {
+            self.prefetch_stamp(c.cross.1);
             self.grid.prefetch_near(c.cross.1);
         } else if let Partner::Ball(j, _) = c.phys.1 {
             prefetch(&self.slots[j as usize]);
@@ -144,6 +165,7 @@ impl Entries for Queued<'_> {
             let slots = self.slots;
             (self.grid).for_each_near(cell, |k| prefetch(&slots[k as usize]));
             self.grid.prefetch_near(self.slots[j as usize].cell);
+            self.prefetch_stamp(self.slots[j as usize].cell);
         }
     }
 }
@@ -172,9 +194,6 @@ pub struct Region {
     journaling: bool,
     /// Old values kept in the batch being run, oldest first.
     pub(super) journal: Vec<Undo>,
-    /// The stretch of the batch being run in which each record's old value was kept last
-    /// (by index; 0: never).
-    kept: Vec<u32>,
     /// The stretch of the batch being run: a batch's start, or one of its own events it runs
     /// on to ([`Region::next_stretch`]).
     stretch: u32,
@@ -207,7 +226,6 @@ impl Region {
             wake: None,
             journaling: false,
             journal: Vec::new(),
-            kept: Vec::new(),
             stretch: 0,
             touched: vec![f64::NEG_INFINITY; cells],
             touching: true,
@@ -291,7 +309,7 @@ impl Region {
     pub(super) fn next_stretch(&mut self) {
         self.stretch = self.stretch.wrapping_add(1).max(1);
         if self.stretch == 1 {
-            self.kept.fill(0);
+            self.cold.iter_mut().for_each(|c| c.kept = 0);
         }
     }
 
@@ -302,11 +320,8 @@ impl Region {
             return;
         }
         let k = i as usize;
-        if k >= self.kept.len() {
-            self.kept.resize(k + 1, 0);
-        }
-        if self.kept[k] != self.stretch {
-            self.kept[k] = self.stretch;
+        if self.cold[k].kept != self.stretch {
+            self.cold[k].kept = self.stretch;
             let (s, c) = (self.slots[k], self.cold[k].clone());
             self.journal.push(Undo::Ball(i, s, c));
         }
@@ -359,6 +374,7 @@ impl Region {
                 self.slots[i as usize] = slot;
                 self.cold[i as usize] = Cold {
                     place: Place::NOWHERE,
+                    kept: 0,
                     ..cold
                 };
                 self.enqueue(i);
@@ -397,6 +413,7 @@ impl Region {
             slots: &self.slots,
             cold: &mut self.cold,
             grid: &self.grid,
+            stamps: (self.journaling && self.touching).then_some(&self.touched[..]),
         };
         (&mut self.queue, entries)
     }
@@ -469,6 +486,7 @@ impl Region {
             queued: never,
             place: Place::NOWHERE,
             column_since: self.now,
+            kept: self.cold[i as usize].kept,
         };
         i
     }
@@ -505,6 +523,7 @@ impl Region {
                     queued: never,
                     place: Place::NOWHERE,
                     column_since: f64::NEG_INFINITY,
+                    kept: 0,
                 });
                 self.grid.hold_balls(self.slots.len());
                 i
