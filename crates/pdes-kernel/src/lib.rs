@@ -638,6 +638,13 @@ impl<'a, M: Model + ?Sized> Ctx<'a, M> {
         self.output.push(out);
     }
 
+    /// Makes room for `n` more outputs, each at a time of its own ([`Ctx::emit_at`]): a batch
+    /// that knows how many it reports spares its vectors their growth.
+    pub fn reserve_output(&mut self, n: usize) {
+        self.output.reserve(n);
+        self.output_times.reserve(n);
+    }
+
     /// Reports output of one of the object's own events the batch ran on to, at `time`
     /// ([`Ctx::may_run`]): executors that hold outputs back order them by these times.
     pub fn emit_at(&mut self, time: VTime<M::Time>, out: M::Output) {

@@ -264,6 +264,13 @@ impl Regions {
                 Region::new(Arc::new(shape), start)
             })
             .collect();
+        // room for every record at once: grown ball by ball, the records were copied over
+        // and over, and the old and new copies held at once
+        for (k, r) in regions.iter_mut().enumerate() {
+            let lo = (cuts[k] as usize).saturating_sub(1);
+            let hi = (cuts[k + 1] as usize + 1).min(per_column.len());
+            r.reserve(per_column[lo..hi].iter().sum());
+        }
         let region_of = |c: u32| cuts.partition_point(|&x| x <= c) as u32 - 1;
         for (i, b) in balls.iter().enumerate() {
             let ghost = Ghost {
@@ -401,6 +408,7 @@ impl Model for Regions {
                 }
                 true
             });
+            ctx.reserve_output(state.reports.len());
             for (key, ev) in state.reports.drain(..) {
                 ctx.emit_at(VTime::at(key), ev);
             }

@@ -234,6 +234,13 @@ impl Region {
         }
     }
 
+    /// Makes room for `n` more records.
+    pub(super) fn reserve(&mut self, n: usize) {
+        self.slots.reserve_exact(n);
+        self.cold.reserve_exact(n);
+        self.local.reserve(n);
+    }
+
     /// Grid columns of its strip.
     pub fn strip_columns(&self) -> u32 {
         self.shape.columns - 2
