@@ -106,13 +106,11 @@ pub(super) struct Queued<'a> {
 }
 
 impl Queued<'_> {
-    /// Starts loading cell `c`'s stamp, when the batch stamps.
+    /// Starts loading cell `c`'s stamp, when the batch stamps (none for [`NOWHERE`]).
     #[inline]
     fn prefetch_stamp(&self, c: u32) {
-        if let Some(stamps) = self.stamps.filter(|_| c != NOWHERE) {
-            if let Some(t) = stamps.get(c as usize) {
-                prefetch(t);
-            }
+        if let Some(t) = self.stamps.and_then(|s| s.get(c as usize)) {
+            prefetch(t);
         }
     }
 }

@@ -35,7 +35,7 @@ impl<M: Model> Open<M> {
     /// A batch's items in their order: sorted by time, when the model emitted them otherwise.
     fn of(c: Committed<M::Time, M::State, M::Output>) -> Open<M> {
         let (mut output, mut times) = (c.output, c.times);
-        if times.windows(2).any(|w| w[1] < w[0]) || times.first().is_some_and(|t| *t < c.time) {
+        if times.windows(2).any(|w| w[1] < w[0]) {
             times.resize(output.len(), c.time.clone());
             let mut pairs: Vec<_> = times.into_iter().zip(output).collect();
             pairs.sort_by(|a, b| a.0.cmp(&b.0));
