@@ -309,9 +309,20 @@ impl<M: Model> Collector<M> {
         &self.states
     }
 
-    /// The committed states, for workers to hand theirs over in place.
+    /// The committed states, for workers to hand theirs over.
     pub(super) fn states_mut(&mut self) -> &mut [M::State] {
         &mut self.states
+    }
+
+    /// Takes the committed states away, for the workers to hold while they run; the collector
+    /// holds none until [`Collector::put_states`].
+    pub(super) fn take_states(&mut self) -> Vec<M::State> {
+        std::mem::take(&mut self.states)
+    }
+
+    /// Gives the collector the committed states back.
+    pub(super) fn put_states(&mut self, states: Vec<M::State>) {
+        self.states = states;
     }
 }
 

@@ -163,7 +163,7 @@ pub struct Chunk<T, S, O> {
     pub last: Option<(TwStats, MessageStats, u64)>,
     /// On the last chunk of a run that ended well, from a worker whose collector runs in
     /// another process: the worker's objects' final states. (Workers beside their collector
-    /// hand theirs over in place: [`Worker::swap_states`](super::Worker::swap_states).)
+    /// hand theirs over in place: [`Worker::hand_back_states`](super::Worker::hand_back_states).)
     pub finals: Vec<(u32, S)>,
     /// Set when the worker stopped on an error.
     pub error: Option<String>,

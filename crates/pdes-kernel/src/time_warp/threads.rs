@@ -41,9 +41,10 @@ pub struct TimeWarp<M: Model> {
     cfg: TwConfig,
     collector: Collector<M>,
     ranks: usize,
-    /// Whether the workers handed their final states to the collector after the last run
-    /// (holding the collector's old ones in their place).
-    handed_over: bool,
+    /// Whether the objects' `init`s have run (on the workers, at the first run).
+    started: bool,
+    /// Start of the run being set up: where the objects start.
+    start: VTime<M::Time>,
     /// Where the last run ended (at first, where the objects started).
     now: f64,
     /// Asks runs to end early.
@@ -94,8 +95,8 @@ where
         let worker_of = map.workers_of(states.len(), per * ranks);
         let placement = Arc::new(Placement::new(&worker_of, per * ranks));
         let mine = rank * per..(rank + 1) * per;
-        // the collector keeps every object's state as it starts; each of this rank's workers
-        // copies its own objects on a thread of its own and runs their `init`s there
+        // the collector keeps every object's state until the first run gives this rank's
+        // workers theirs and runs their `init`s
         let mut ids: Vec<Vec<u32>> = (0..per).map(|_| Vec::new()).collect();
         for o in 0..states.len() as u32 {
             let w = placement.worker(o);
@@ -103,39 +104,11 @@ where
                 ids[w - mine.start].push(o);
             }
         }
-        let (model_ref, states_ref) = (&model, &states);
-        let mut workers: Vec<Worker<M>> = std::thread::scope(|scope| {
-            let handles: Vec<_> = ids
-                .into_iter()
-                .enumerate()
-                .map(|(k, ids)| {
-                    let (placement, start) = (placement.clone(), &start);
-                    scope.spawn(move || {
-                        let own: Vec<(u32, M::State)> = ids
-                            .into_iter()
-                            .map(|o| (o, states_ref[o as usize].clone()))
-                            .collect();
-                        let mut w = Worker::new(mine.start + k, placement, own, cfg.chaos);
-                        w.init(model_ref, start);
-                        w
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().expect("a worker's set-up does not panic"))
-                .collect()
-        });
-        // init's sends to this rank's workers are delivered here; others wait in outboxes
-        let mut mail: Vec<Vec<Op<M::Time, M::Msg>>> = (0..per).map(|_| Vec::new()).collect();
-        for w in &mut workers {
-            for (to, ops) in w.take_outbox(mine.clone()) {
-                mail[to - mine.start].extend(ops);
-            }
-        }
-        for (w, ops) in workers.iter_mut().zip(mail) {
-            w.accept(ops);
-        }
+        let workers = ids
+            .into_iter()
+            .enumerate()
+            .map(|(k, ids)| Worker::new(mine.start + k, placement.clone(), ids, cfg.chaos))
+            .collect();
         let mut collector = Collector::new(states);
         collector.records = cfg.record_rounds.then(Vec::new);
         TimeWarp {
@@ -144,15 +117,100 @@ where
             cfg,
             collector,
             ranks,
-            handed_over: false,
+            started: false,
             now: start.t(),
+            start,
             interrupt: None,
+        }
+    }
+
+    /// Gives the workers their objects' states, each on its own thread, and runs the objects'
+    /// `init`s there before the first run. The states move from the collector, unless it
+    /// still needs them: to show the sink observed states, or to take other ranks' final
+    /// states in. There they are copied, and the collector holds every object twice.
+    fn hand_out(&mut self) {
+        if self.workers.iter().all(Worker::holds_states) {
+            return;
+        }
+        let moved = self.ranks == 1 && !self.collector.shipped;
+        let mut states: Vec<Option<M::State>> = if moved {
+            self.collector.take_states().into_iter().map(Some).collect()
+        } else {
+            Vec::new()
+        };
+        let copies = self.collector.states();
+        let (model, start, init) = (&self.model, &self.start, !self.started);
+        let mut parts: Vec<Vec<(u32, M::State)>> = Vec::with_capacity(self.workers.len());
+        for w in &self.workers {
+            let ids = w.ids();
+            parts.push(if moved {
+                ids.map(|o| (o, states[o as usize].take().expect("one owner")))
+                    .collect()
+            } else {
+                Vec::new()
+            });
+        }
+        std::thread::scope(|scope| {
+            for (w, part) in self.workers.iter_mut().zip(parts) {
+                scope.spawn(move || {
+                    let mut part = part.into_iter();
+                    w.give_states(|o| match part.next() {
+                        Some((_, state)) => state,
+                        None => copies[o as usize].clone(),
+                    });
+                    if init {
+                        w.init(model, start);
+                    }
+                });
+            }
+        });
+        if init {
+            self.deliver_init_mail();
+        }
+        self.started = true;
+    }
+
+    /// Delivers the `init`s' sends to this rank's workers; those for other ranks wait in
+    /// outboxes for the first run's fabric.
+    fn deliver_init_mail(&mut self) {
+        let per = self.workers.len();
+        let first = place().0 * per;
+        let mut mail: Vec<Vec<Op<M::Time, M::Msg>>> = (0..per).map(|_| Vec::new()).collect();
+        for w in &mut self.workers {
+            for (to, ops) in w.take_outbox(first..first + per) {
+                mail[to - first].extend(ops);
+            }
+        }
+        for (w, ops) in self.workers.iter_mut().zip(mail) {
+            w.accept(ops);
+        }
+    }
+
+    /// Takes the workers' final states back into the collector, by move.
+    fn hand_back(&mut self) {
+        if self.collector.states().is_empty() {
+            let n = self.workers.iter().map(|w| w.ids().count()).sum();
+            let mut states: Vec<Option<M::State>> = (0..n).map(|_| None).collect();
+            for w in &mut self.workers {
+                w.hand_back_states(|o, state| states[o as usize] = Some(state));
+            }
+            let states = states.into_iter().map(|s| s.expect("one owner")).collect();
+            self.collector.put_states(states);
+        } else {
+            let held = self.collector.states_mut();
+            for w in &mut self.workers {
+                w.hand_back_states(|o, state| held[o as usize] = state);
+            }
         }
     }
 
     /// Frees the workers' objects, messages and records, each on its own thread: the thread
     /// that allocated most of them, and a large run holds hundreds of megabytes.
     pub fn free(mut self) {
+        if self.ranks == 1 && self.started {
+            self.collector.shipped = false;
+            self.hand_out();
+        }
         let workers = std::mem::take(&mut self.workers);
         std::thread::scope(|scope| {
             for w in workers {
@@ -219,11 +277,7 @@ where
     /// (on rank 0 only, under MPI). Returns the time the run ended at: `until`, or an earlier
     /// one where an interrupt ([`TimeWarp::stop_on`]) ended it, every batch up to it run.
     pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, ExecError<E>> {
-        if std::mem::take(&mut self.handed_over) {
-            for w in &mut self.workers {
-                w.restore_states(self.collector.states());
-            }
-        }
+        self.hand_out();
         let (tx, rx) = mpsc::channel();
         let mut failed: Option<ExecError<E>> = None;
         self.collector.begin_run();
@@ -251,12 +305,10 @@ where
                 }
             }
         }
-        // the workers of the collecting process hand their final states over in place
-        if failed.is_none() && collects_results() {
-            for w in &mut self.workers {
-                w.swap_states(self.collector.states_mut());
-            }
-            self.handed_over = true;
+        // the workers of the collecting process hand their final states over (and where
+        // they moved from it, after a failed run too)
+        if collects_results() && (failed.is_none() || self.collector.states().is_empty()) {
+            self.hand_back();
         }
         if let Some(e) = failed {
             return Err(e);
@@ -566,6 +618,7 @@ mod tests {
         let (tx, rx) = mpsc::channel();
         let liar = Liar(ThreadFabric::new(2, tx));
         let mut failed: Option<ExecError<()>> = None;
+        tw.hand_out();
         tw.drive(&liar, &rx, 30.0, &mut |_, _, _| Ok(()), &mut failed);
         match failed {
             Some(ExecError::Failed(m)) => assert!(m.contains("ran as final"), "{m}"),

@@ -308,7 +308,8 @@ struct Taken<M: Model> {
 /// One object (a logical process) on its worker.
 struct Lp<M: Model> {
     id: u32,
-    state: M::State,
+    /// Its state; `None` between runs while the executor's collector holds it.
+    state: Option<M::State>,
     seq: u64,
     uids: u64,
     /// Its uncommitted batches in its worker's log.
@@ -485,23 +486,33 @@ pub enum Stop {
     Failed(String),
 }
 
+/// Why a state is there: the executor gives the workers their objects' states before they
+/// run, and takes them back only after.
+const HELD: &str = "a worker holds its objects' states while it runs";
+
+/// The state of an object of a worker that runs.
+fn held<S>(state: &mut Option<S>) -> &mut S {
+    state.as_mut().expect(HELD)
+}
+
 impl<M: Model> Worker<M> {
-    /// A worker holding the objects `placement` gives it, with their initial states.
+    /// A worker for the objects `ids` (those `placement` gives it), without their states:
+    /// it gets them with [`Worker::give_states`] before it runs.
     pub fn new(
         index: usize,
         placement: std::sync::Arc<Placement>,
-        states: Vec<(u32, M::State)>,
+        ids: Vec<u32>,
         chaos: Option<u64>,
     ) -> Worker<M> {
         let workers = placement.workers();
-        let n_objects = states.len();
+        let n_objects = ids.len();
         Worker {
             index,
-            lps: states
+            lps: ids
                 .into_iter()
-                .map(|(id, state)| Lp {
+                .map(|id| Lp {
                     id,
-                    state,
+                    state: None,
                     seq: 0,
                     uids: 0,
                     history: Chain::EMPTY,
@@ -575,7 +586,7 @@ impl<M: Model> Worker<M> {
             let lp = &mut self.lps[k];
             let (id, first) = (lp.id, lp.uids);
             let mut ctx = Ctx::new(model, start.clone(), id, &mut lp.seq).named(&mut lp.uids);
-            model.init(&mut ctx, id, &mut lp.state);
+            model.init(&mut ctx, id, held(&mut lp.state));
             let sent = ctx.sent;
             assert!(ctx.cancelled.is_empty(), "init may not cancel");
             for (n, p) in (first + 1..).zip(sent) {
@@ -613,20 +624,32 @@ impl<M: Model> Worker<M> {
         self.heap.len() + self.marks.set_aside_len()
     }
 
-    /// Exchanges each of this worker's objects' states with its entry in `states` (indexed by
-    /// object): after a run, a collector beside the workers takes the final states this way,
-    /// moving them rather than copying them; the workers get them back with
-    /// [`Worker::restore_states`] before they run again.
-    pub fn swap_states(&mut self, states: &mut [M::State]) {
+    /// This worker's objects, in the order it holds them.
+    pub fn ids(&self) -> impl Iterator<Item = u32> + '_ {
+        self.lps.iter().map(|lp| lp.id)
+    }
+
+    /// Whether the worker holds its objects' states.
+    pub fn holds_states(&self) -> bool {
+        self.lps.iter().all(|lp| lp.state.is_some())
+    }
+
+    /// Gives each of this worker's objects its state, `state(id)`.
+    pub fn give_states(&mut self, mut state: impl FnMut(u32) -> M::State) {
         for lp in &mut self.lps {
-            std::mem::swap(&mut lp.state, &mut states[lp.id as usize]);
+            lp.state = Some(state(lp.id));
         }
     }
 
-    /// Sets each of this worker's objects' states to a copy of its entry in `states`.
-    pub fn restore_states(&mut self, states: &[M::State]) {
+    /// Hands each of this worker's objects' states to `take(id, state)`, moving it rather
+    /// than copying it: after a run, the collector beside the workers takes the final states
+    /// this way, and the worker gets them back with [`Worker::give_states`] before it runs
+    /// again.
+    pub fn hand_back_states(&mut self, mut take: impl FnMut(u32, M::State)) {
         for lp in &mut self.lps {
-            lp.state = states[lp.id as usize].clone();
+            if let Some(state) = lp.state.take() {
+                take(lp.id, state);
+            }
         }
     }
 
@@ -910,12 +933,12 @@ impl<M: Model> Worker<M> {
         self.stats.ran_on_undone += d.span.as_ref().map_or(0, |s| s.marks.len()) as u64;
         match d.saved {
             Saved::Copy(class, pre_state) => {
-                let undone = std::mem::replace(&mut lp.state, pre_state);
+                let undone = std::mem::replace(held(&mut lp.state), pre_state);
                 self.give_state(class, undone);
             }
             Saved::Journal(mut journal, restore) => {
                 while let Some(undo) = journal.pop() {
-                    restore(&mut lp.state, undo);
+                    restore(held(&mut lp.state), undo);
                 }
                 give(&mut self.spare.journals, journal);
             }
@@ -986,7 +1009,7 @@ impl<M: Model> Worker<M> {
         };
         let from = span.marks[m].1;
         while journal.len() > from {
-            restore(&mut lp.state, journal.pop().expect("a record"));
+            restore(held(&mut lp.state), journal.pop().expect("a record"));
         }
         self.stats.ran_on_undone += (span.marks.len() - m) as u64;
         let end = std::mem::replace(
@@ -1076,7 +1099,7 @@ impl<M: Model> Worker<M> {
                 .named(&mut lp.uids)
                 .journaled(journal);
             ctx.sent = std::mem::take(&mut self.spare.pending);
-            model.cut(&mut ctx, id, &mut lp.state);
+            model.cut(&mut ctx, id, held(&mut lp.state));
             assert!(ctx.output.is_empty(), "a cut batch's end emits nothing");
             let (mut sent, cancelled) = (ctx.sent, ctx.cancelled);
             d.into_past = ctx.into_past;
@@ -1109,7 +1132,7 @@ impl<M: Model> Worker<M> {
             return Saved::Journal(take(&mut self.spare.journals), restore);
         }
         let class = model.state_class(id).min(STATE_CLASSES - 1);
-        let state = &self.lps[li].state;
+        let state = self.lps[li].state.as_ref().expect(HELD);
         let copy = match self.spare.states[class].pop() {
             Some(mut saved) => {
                 saved.clone_from(state);
@@ -1254,7 +1277,7 @@ impl<M: Model> Worker<M> {
             ctx = ctx.with_horizon(h);
         }
         ctx.sent = std::mem::take(&mut self.spare.pending);
-        model.handle(&mut ctx, to, &mut lp.state, &taken.batch);
+        model.handle(&mut ctx, to, held(&mut lp.state), &taken.batch);
         let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
         let into_past = ctx.into_past;
         let span = (ctx.reached.is_some() || !ctx.output_times.is_empty()).then(|| {
@@ -1324,7 +1347,7 @@ impl<M: Model> Worker<M> {
                 .journaled(&mut journal);
             ctx.reached = Some(end.clone());
             ctx.sent = std::mem::take(&mut self.spare.pending);
-            let taken_in = model.take_in(&mut ctx, to, &mut lp.state, &taken.batch, again);
+            let taken_in = model.take_in(&mut ctx, to, held(&mut lp.state), &taken.batch, again);
             debug_assert!(taken_in || !again, "a batch taken in again is taken in");
             let (mut sent, cancelled, output) = (ctx.sent, ctx.cancelled, ctx.output);
             let into_past = ctx.into_past;
@@ -1355,7 +1378,7 @@ impl<M: Model> Worker<M> {
                 return;
             }
             while let Some(undo) = journal.pop() {
-                restore(&mut lp.state, undo);
+                restore(held(&mut lp.state), undo);
             }
             give(&mut self.spare.journals, journal);
             (lp.seq, lp.uids) = (pre_seq, first);
@@ -1564,7 +1587,8 @@ impl<M: Model> Worker<M> {
                 });
             }
         }
-        let state = (self.ship && model.observed(id)).then(|| self.lps[li].state.clone());
+        let state = (self.ship && model.observed(id))
+            .then(|| self.lps[li].state.as_ref().expect(HELD).clone());
         let times = output_times(did.span);
         self.keep_for_collector(did.time, id, state, did.output, times);
     }
@@ -1865,7 +1889,7 @@ impl<M: Model> Worker<M> {
         if let Some(Saved::Copy(_, state)) = self.log.second(&lp.history).map(|d| &d.saved) {
             return state.clone();
         }
-        let mut state = lp.state.clone();
+        let mut state = lp.state.as_ref().expect(HELD).clone();
         for d in self.log.after_first_newest_first(&lp.history) {
             match &d.saved {
                 Saved::Copy(_, before) => state.clone_from(before),
@@ -2186,7 +2210,7 @@ impl<M: Model> Worker<M> {
         let finals = if result.is_ok() && !fabric.collector_is_local() {
             self.lps
                 .iter()
-                .map(|lp| (lp.id, lp.state.clone()))
+                .map(|lp| (lp.id, lp.state.as_ref().expect(HELD).clone()))
                 .collect()
         } else {
             Vec::new()
