@@ -64,6 +64,9 @@ pub struct RegionsSummary {
     pub balls_start: Vec<usize>,
     /// Balls each region owned at the end.
     pub balls_end: Vec<usize>,
+    /// Physical events each region reported (a collision across a border counts for one of
+    /// its two regions): how evenly the work was spread.
+    pub events: Vec<u64>,
     /// Physical events run by two regions: collisions across a border.
     pub events_across: u64,
     /// Their fraction of all physical events.

@@ -19,6 +19,8 @@ pub struct RegionsEngine {
     balls_start: Vec<usize>,
     /// Committed events run by two regions, and all committed events, so far.
     across: (u64, u64),
+    /// Committed events each region reported, so far.
+    events: Vec<u64>,
 }
 
 /// The committed regions as the balls they own, for observers.
@@ -76,7 +78,7 @@ impl RegionsEngine {
         tw: Option<TwConfig>,
     ) -> Result<RegionsEngine, RegionsError> {
         let (model, states) = Regions::new(s, count, start)?;
-        let balls_start = states.iter().map(Region::owned).collect();
+        let balls_start: Vec<usize> = states.iter().map(Region::owned).collect();
         let start = VTime::start(start);
         let exec: Box<dyn Executor<Regions, RunError>> = match tw {
             None => Box::new(Sequential::new(model, states, start)),
@@ -95,6 +97,7 @@ impl RegionsEngine {
         };
         Ok(RegionsEngine {
             exec,
+            events: vec![0; balls_start.len()],
             balls_start,
             across: (0, 0),
         })
@@ -127,13 +130,14 @@ impl super::Engine for RegionsEngine {
         let n = self.exec.model().n_balls();
         let mut instant = InstantCap::new(n as usize);
         self.exec.observe_states(obs.reads_balls());
-        let across = &mut self.across;
+        let (across, events) = (&mut self.across, &mut self.events);
         let ended = self
             .exec
             .run(until, &mut |model: &Regions, states: &[Region], out| {
                 let ev = out.event;
                 across.0 += u64::from(out.across);
                 across.1 += 1;
+                events[out.region as usize] += 1;
                 instant.count(&ev)?;
                 counts.add(ev.kind);
                 let view = View {
@@ -182,6 +186,7 @@ impl super::Engine for RegionsEngine {
             columns: states.iter().map(Region::strip_columns).collect(),
             balls_start: self.balls_start.clone(),
             balls_end: states.iter().map(Region::owned).collect(),
+            events: self.events.clone(),
             events_across: self.across.0,
             fraction_across: self.across.0 as f64 / self.across.1.max(1) as f64,
             messages,

@@ -229,7 +229,7 @@ impl Region {
             };
             let across = sa.owner != sb.owner;
             self.reports
-                .push((key.clone(), RegionEvent { event, across }));
+                .push((key.clone(), RegionEvent { event, across, region: self.shape.me }));
         }
         self.turn(a, key, va);
         self.turn(b, key, vb);
@@ -254,6 +254,7 @@ impl Region {
             RegionEvent {
                 event,
                 across: false,
+                region: self.shape.me,
             },
         ));
         let column = self.grid.column(s.cell);

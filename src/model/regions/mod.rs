@@ -91,6 +91,9 @@ pub struct RegionEvent {
     pub event: Event,
     /// Whether two regions ran it (a collision across a border).
     pub across: bool,
+    /// The region that reported it (for a collision across a border, the one that ran it
+    /// first).
+    pub region: u32,
 }
 
 /// The message types, by [`Model::kind`].
