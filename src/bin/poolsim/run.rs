@@ -214,12 +214,14 @@ pub fn engine_of(a: &RunArgs, scenario: &Scenario) -> Result<EngineKind, Failure
         }
         Engine::Regions => {
             let tw = tw_config(a)?;
-            let count = a.regions.unwrap_or(tw.workers as u32);
+            // every rank's workers, under MPI
+            let workers = pdes_kernel::time_warp::threads::total_workers(&tw);
+            let count = a.regions.unwrap_or(workers as u32);
             if count == 0 {
                 return Err(usage("--regions: must be at least 1"));
             }
             // one worker runs the regions in turn on the sequential executor
-            let tw = (tw.workers > 1).then_some(tw);
+            let tw = (workers > 1).then_some(tw);
             Ok(EngineKind::Regions { count, tw })
         }
         Engine::TimeWarp => {
@@ -495,16 +497,17 @@ pub fn run_from(
     scenario: &Scenario,
     from: Option<&Checkpoint>,
 ) -> Result<(), Failure> {
-    let mut cfg = config_of(a, scenario, from)?;
-    let interrupt = Interrupt::new();
-    stop_on_signals(&interrupt)?;
-    cfg.interrupt = Some(interrupt.clone());
+    // the engines on Time Warp run across ranks: their layout counts every rank's workers
     #[cfg(feature = "mpi")]
-    let _mpi = if matches!(cfg.engine, EngineKind::TimeWarp { .. }) {
+    let _mpi = if matches!(a.engine, Engine::TimeWarp | Engine::Regions) {
         start_mpi()?
     } else {
         None
     };
+    let mut cfg = config_of(a, scenario, from)?;
+    let interrupt = Interrupt::new();
+    stop_on_signals(&interrupt)?;
+    cfg.interrupt = Some(interrupt.clone());
     // under MPI only rank 0 writes anything
     let root = pdes_kernel::time_warp::threads::collects_results();
     let mark = from.and_then(|c| c.trace.as_ref());

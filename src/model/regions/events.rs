@@ -228,8 +228,14 @@ impl Region {
                 b: sb.gid,
             };
             let across = sa.owner != sb.owner;
-            self.reports
-                .push((key.clone(), RegionEvent { event, across, region: self.shape.me }));
+            self.reports.push((
+                key.clone(),
+                RegionEvent {
+                    event,
+                    across,
+                    region: self.shape.me,
+                },
+            ));
         }
         self.turn(a, key, va);
         self.turn(b, key, vb);

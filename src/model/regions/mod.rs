@@ -468,20 +468,71 @@ impl Model for Regions {
     }
 }
 
-/// Regions travel between ranks only as their balls; they do not yet.
+/// A region as it travels from one MPI rank to another: its place and the balls it owns. The
+/// rank that collects results reads only those (final states, and observed states for
+/// `--check` and frames); it never runs a region of another rank.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Travelling {
+    me: u32,
+    columns: u32,
+    rows: u32,
+    lo: Vec2,
+    hi: Vec2,
+    rmax: f64,
+    left: Option<u32>,
+    right: Option<u32>,
+    now: f64,
+    balls: Vec<Ghost>,
+}
+
 impl serde::Serialize for Region {
-    fn serialize<S: serde::Serializer>(&self, _s: S) -> Result<S::Ok, S::Error> {
-        Err(serde::ser::Error::custom(
-            "a region's state does not travel between MPI ranks",
-        ))
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let shape = &self.shape;
+        Travelling {
+            me: shape.me,
+            columns: shape.columns,
+            rows: shape.rows,
+            lo: shape.table.lo,
+            hi: shape.table.hi,
+            rmax: shape.rmax,
+            left: shape.left,
+            right: shape.right,
+            now: self.now,
+            balls: self.owned_balls(),
+        }
+        .serialize(s)
     }
 }
 
 impl<'de> serde::Deserialize<'de> for Region {
-    fn deserialize<D: serde::Deserializer<'de>>(_d: D) -> Result<Region, D::Error> {
-        Err(serde::de::Error::custom(
-            "a region's state does not travel between MPI ranks",
-        ))
+    /// A region holding the balls it owned where it was sent: it answers for them
+    /// ([`Region::ball`], [`Region::owned`]), and runs nothing.
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Region, D::Error> {
+        let t = Travelling::deserialize(d)?;
+        let table = Table {
+            n_balls: 0,
+            cushions: Vec::new(),
+            pockets: Vec::new(),
+            corners: Vec::new(),
+            lo: t.lo,
+            hi: t.hi,
+            period: None,
+        };
+        let shape = Shape {
+            me: t.me,
+            table,
+            columns: t.columns,
+            rows: t.rows,
+            rmax: t.rmax,
+            left: t.left,
+            right: t.right,
+        };
+        let mut region = Region::new(Arc::new(shape), t.now);
+        region.reserve(t.balls.len());
+        for g in &t.balls {
+            region.admit(g, t.me, None);
+        }
+        Ok(region)
     }
 }
 

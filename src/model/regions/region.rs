@@ -570,6 +570,17 @@ impl Region {
     }
 
     /// Record `i` as news for a neighbour.
+    /// The balls it owns, as their neighbours would hear of them.
+    pub(super) fn owned_balls(&self) -> Vec<Ghost> {
+        let me = self.shape.me;
+        let mut balls: Vec<Ghost> = (self.local.values())
+            .filter(|&&i| self.slots[i as usize].owner == me)
+            .map(|&i| self.ghost_of(i))
+            .collect();
+        balls.sort_by_key(|g| g.gid);
+        balls
+    }
+
     pub(super) fn ghost_of(&self, i: u32) -> Ghost {
         let (s, c) = (&self.slots[i as usize], &self.cold[i as usize]);
         Ghost {
