@@ -1,6 +1,7 @@
 //! Time Warp across MPI ranks (cargo feature `mpi`, OpenMPI's `mpirun` on the path): on 2 and 3
 //! ranks on loopback, with and without chaos, pool and PHOLD give the sequential objects
-//! engine's trace and final-state digest, bit for bit.
+//! engine's trace and final-state digest, bit for bit, and the regions engine the event
+//! list's.
 #![cfg(feature = "mpi")]
 
 use std::path::Path;
@@ -177,6 +178,110 @@ fn phold_on_ranks() {
         assert_eq!(got["committed"], want["committed"]);
         assert_eq!(got["time_warp"]["ranks"], ranks);
     }
+}
+
+/// The event list's trace and digest against the regions engine's on 2 and 3 ranks, with
+/// and without chaos, with as many regions as workers and with more.
+fn assert_regions_same(
+    scenario: &str,
+    extra: &[&str],
+    layouts: &[(usize, &str, &str, Option<u64>)],
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let want_trace = dir.path().join("want.jsonl");
+    let mut args = vec!["run", scenario, "--json", "--quiet"];
+    args.extend_from_slice(extra);
+    let mut seq = args.clone();
+    seq.extend(["--trace", want_trace.to_str().unwrap()]);
+    let want = poolsim(None, None, &seq);
+    for &(ranks, workers, regions, chaos) in layouts {
+        let got_trace = dir
+            .path()
+            .join(format!("got-{ranks}-{workers}-{regions}.jsonl"));
+        let mut rg = args.clone();
+        rg.extend([
+            "--engine",
+            "regions",
+            "--workers",
+            workers,
+            "--regions",
+            regions,
+        ]);
+        rg.extend(["--trace", got_trace.to_str().unwrap()]);
+        let got = poolsim(Some(ranks), chaos, &rg);
+        let what = format!(
+            "{scenario} {extra:?}: {regions} regions on {ranks} ranks x {workers}, chaos {chaos:?}"
+        );
+        assert_eq!(
+            got["final_state_digest"], want["final_state_digest"],
+            "{what}"
+        );
+        assert_eq!(got["events"], want["events"], "{what}");
+        assert_eq!(got["time_warp"]["ranks"], ranks, "{what}");
+        let owned: u64 = (got["regions"]["balls_end"].as_array().unwrap().iter())
+            .map(|n| n.as_u64().unwrap())
+            .sum();
+        assert_eq!(
+            owned,
+            got["balls"].as_u64().unwrap(),
+            "{what}: every ball has an owner"
+        );
+        assert_eq!(read(&got_trace), read(&want_trace), "{what}: traces differ");
+    }
+}
+
+/// The regions engine on ranks: a dense gas cut in strips across ranks, and the break, give
+/// the event list's answer.
+#[test]
+fn regions_on_ranks() {
+    let layouts = [
+        (2, "1", "2", None),
+        (3, "1", "4", None),
+        (2, "1", "3", Some(5)),
+        (2, "2", "4", Some(9)),
+    ];
+    let dense = ["--balls", "3000", "--area-fraction", "0.6", "--until", "2"];
+    assert_regions_same("disks", &dense, &layouts);
+    assert_regions_same("pool", &[], &layouts[..2]);
+}
+
+/// Every hard case on the regions engine across 2 ranks.
+#[test]
+fn hard_cases_on_ranks_in_regions() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+    let mut n = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            assert_regions_same(path.to_str().unwrap(), &[], &[(2, "1", "2", Some(3))]);
+            n += 1;
+        }
+    }
+    assert!(n >= 10);
+}
+
+/// `--check` with the regions engine on 2 ranks: the collecting rank checks every event with
+/// the balls the other rank's regions send it.
+#[test]
+fn checked_regions_on_ranks() {
+    let args = [
+        "run",
+        "disks",
+        "--balls",
+        "800",
+        "--area-fraction",
+        "0.6",
+        "--until",
+        "1",
+    ];
+    let mut seq = args.to_vec();
+    seq.extend(["--check", "--json", "--quiet"]);
+    let want = poolsim(None, None, &seq);
+    let mut rg = seq.clone();
+    rg.extend(["--engine", "regions", "--workers", "1", "--regions", "3"]);
+    let got = poolsim(Some(2), None, &rg);
+    assert_eq!(got["checked"], true);
+    assert_eq!(got["final_state_digest"], want["final_state_digest"]);
 }
 
 /// `--check` on ranks: every committed event and the final state are checked, and only rank 0,
