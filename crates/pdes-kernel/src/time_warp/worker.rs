@@ -1992,7 +1992,12 @@ impl<M: Model> Worker<M> {
         let result = loop {
             self.iteration += 1;
             self.receive(fabric, &mut buf);
-            let window = self.window_base(fabric) + cfg.window.unwrap_or(self.auto_window.width);
+            // a window set is narrowed by rollbacks as the adaptive one is
+            let width = match cfg.window {
+                Some(w) => w * self.auto_window.scale,
+                None => self.auto_window.width,
+            };
+            let window = self.window_base(fabric) + width;
             let (ran, held_back) = self.burst(model, fabric, cfg, until.min(window), ahead);
             self.flush(model, fabric);
             self.commit_early(model);
