@@ -82,7 +82,8 @@ where
     M::Output: Send,
 {
     /// Places the objects on the workers of every rank as `map` says (the [`total_workers`]
-    /// workers numbered rank by rank) and runs the `init` of this rank's objects at `start`.
+    /// workers numbered rank by rank), to start at `start`: the first run gives this rank's
+    /// workers their objects' states and runs the objects' `init`s.
     pub fn new(
         model: M,
         states: Vec<M::State>,
