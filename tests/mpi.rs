@@ -130,18 +130,23 @@ fn the_break_on_ranks() {
     assert_same("pool", &["--sectors", "2"]);
 }
 
+/// The hard cases' scenario files (at least 10 of them).
+fn hard_cases() -> Vec<String> {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
+    let cases: Vec<String> = (std::fs::read_dir(dir).unwrap())
+        .map(|entry| entry.unwrap().path())
+        .filter(|path| path.extension().is_some_and(|e| e == "toml"))
+        .map(|path| path.to_str().unwrap().to_string())
+        .collect();
+    assert!(cases.len() >= 10, "{} hard cases", cases.len());
+    cases
+}
+
 #[test]
 fn hard_cases_on_ranks() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
-    let mut n = 0;
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "toml") {
-            assert_same(path.to_str().unwrap(), &["--sectors", "2"]);
-            n += 1;
-        }
+    for case in hard_cases() {
+        assert_same(&case, &["--sectors", "2"]);
     }
-    assert!(n >= 10);
 }
 
 #[test]
@@ -248,16 +253,9 @@ fn regions_on_ranks() {
 /// Every hard case on the regions engine across 2 ranks.
 #[test]
 fn hard_cases_on_ranks_in_regions() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios");
-    let mut n = 0;
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "toml") {
-            assert_regions_same(path.to_str().unwrap(), &[], &[(2, "1", "2", Some(3))]);
-            n += 1;
-        }
+    for case in hard_cases() {
+        assert_regions_same(&case, &[], &[(2, "1", "2", Some(3))]);
     }
-    assert!(n >= 10);
 }
 
 /// `--check` with the regions engine on 2 ranks: the collecting rank checks every event with

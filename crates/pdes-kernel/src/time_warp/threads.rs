@@ -126,14 +126,13 @@ where
     }
 
     /// Gives the workers their objects' states, each on its own thread, and runs the objects'
-    /// `init`s there before the first run. The states move from the collector, unless it
-    /// still needs them: to show the sink observed states, or to take other ranks' final
-    /// states in. There they are copied, and the collector holds every object twice.
-    fn hand_out(&mut self) {
+    /// `init`s there before the first run. The states move from the collector when `moved`
+    /// (one process, and a collector that needs none during the run); otherwise the workers
+    /// get copies, and the collector holds every object twice.
+    fn hand_out(&mut self, moved: bool) {
         if self.workers.iter().all(Worker::holds_states) {
             return;
         }
-        let moved = self.ranks == 1 && !self.collector.shipped;
         let mut states: Vec<Option<M::State>> = if moved {
             self.collector.take_states().into_iter().map(Some).collect()
         } else {
@@ -141,24 +140,20 @@ where
         };
         let copies = self.collector.states();
         let (model, start, init) = (&self.model, &self.start, !self.started);
-        let mut parts: Vec<Vec<(u32, M::State)>> = Vec::with_capacity(self.workers.len());
-        for w in &self.workers {
-            let ids = w.ids();
-            parts.push(if moved {
-                ids.map(|o| (o, states[o as usize].take().expect("one owner")))
+        // each worker's states in the order it holds its objects; none where they are copied
+        let parts: Vec<Vec<M::State>> = (self.workers.iter())
+            .map(|w| {
+                w.ids()
+                    .filter(|_| moved)
+                    .map(|o| states[o as usize].take().expect("one owner"))
                     .collect()
-            } else {
-                Vec::new()
-            });
-        }
+            })
+            .collect();
         std::thread::scope(|scope| {
             for (w, part) in self.workers.iter_mut().zip(parts) {
                 scope.spawn(move || {
                     let mut part = part.into_iter();
-                    w.give_states(|o| match part.next() {
-                        Some((_, state)) => state,
-                        None => copies[o as usize].clone(),
-                    });
+                    w.give_states(|o| part.next().unwrap_or_else(|| copies[o as usize].clone()));
                     if init {
                         w.init(model, start);
                     }
@@ -209,8 +204,7 @@ where
     /// that allocated most of them, and a large run holds hundreds of megabytes.
     pub fn free(mut self) {
         if self.ranks == 1 && self.started {
-            self.collector.shipped = false;
-            self.hand_out();
+            self.hand_out(true);
         }
         let workers = std::mem::take(&mut self.workers);
         std::thread::scope(|scope| {
@@ -278,7 +272,8 @@ where
     /// (on rank 0 only, under MPI). Returns the time the run ended at: `until`, or an earlier
     /// one where an interrupt ([`TimeWarp::stop_on`]) ended it, every batch up to it run.
     pub fn run<E>(&mut self, until: f64, sink: &mut Sink<'_, M, E>) -> Result<f64, ExecError<E>> {
-        self.hand_out();
+        // the collector keeps a copy where it shows the sink states or takes other ranks'
+        self.hand_out(self.ranks == 1 && !self.collector.shipped);
         let (tx, rx) = mpsc::channel();
         let mut failed: Option<ExecError<E>> = None;
         self.collector.begin_run();
@@ -619,7 +614,7 @@ mod tests {
         let (tx, rx) = mpsc::channel();
         let liar = Liar(ThreadFabric::new(2, tx));
         let mut failed: Option<ExecError<()>> = None;
-        tw.hand_out();
+        tw.hand_out(true);
         tw.drive(&liar, &rx, 30.0, &mut |_, _, _| Ok(()), &mut failed);
         match failed {
             Some(ExecError::Failed(m)) => assert!(m.contains("ran as final"), "{m}"),
